@@ -1,0 +1,31 @@
+// Command-line options shared by the subcommands: the SPEC §2 camera
+// overrides and the image size.
+#pragma once
+
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "common/camera.h"
+
+namespace rastray {
+
+// Default image size when --size is not given.
+constexpr int kDefaultWidth = 640;
+constexpr int kDefaultHeight = 480;
+
+struct CameraOptions {
+  std::vector<double> eye, target, up;  // 3 values each when given
+  double yfov = 0, znear = 0, zfar = 0;
+  CLI::Option* yfovOption = nullptr;
+  CLI::Option* znearOption = nullptr;
+  CLI::Option* zfarOption = nullptr;
+  std::vector<int> size{kDefaultWidth, kDefaultHeight};
+
+  void addTo(CLI::App& app);
+  CameraOverrides overrides() const;
+  int width() const { return size[0]; }
+  int height() const { return size[1]; }
+};
+
+}  // namespace rastray

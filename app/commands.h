@@ -1,0 +1,15 @@
+// The rastray subcommands. Each registers its options on the CLI and
+// returns the function that runs it (exit status per SPEC §7).
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace rastray {
+
+using CommandRunner = std::function<int()>;
+
+CommandRunner addInfoCommand(CLI::App& app);
+
+}  // namespace rastray

@@ -1,0 +1,56 @@
+// rastray: one glTF scene, two renderers, and where they differ.
+//
+// Exit status (SPEC §7): 0 success; 1 a comparison fell below its
+// threshold; 2 bad usage or bad input, with one line on stderr naming the
+// file and the offending element.
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "app/commands.h"
+#include "common/error.h"
+
+int main(int argc, char** argv) {
+  using namespace rastray;
+  CLI::App app{"rastray: render one glTF scene with a z-buffer rasterizer and an Embree ray caster, "
+               "and compare them sample by sample"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "rastray 0.1");
+  std::vector<CommandRunner> commands;
+  commands.push_back(addInfoCommand(app));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::printf("%s", app.help().c_str());
+    return 0;
+  } catch (const CLI::CallForAllHelp&) {
+    std::printf("%s", app.help("", CLI::AppFormatMode::All).c_str());
+    return 0;
+  } catch (const CLI::CallForVersion&) {
+    std::printf("rastray 0.1\n");
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "rastray: %s (see rastray --help)\n", e.what());
+    return 2;
+  }
+
+  try {
+    for (const CommandRunner& run : commands) {
+      const int status = run();
+      if (status >= 0) return status;
+    }
+    return 2;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "rastray: out of memory\n");
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rastray: %s\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,182 @@
+#include "common/camera.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "common/error.h"
+
+namespace rastray {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+[[noreturn]] void badOption(const std::string& option, const std::string& message) {
+  throw InputError("command line", option, message);
+}
+
+std::string fmt(const glm::dvec3& v) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", v.x, v.y, v.z);
+  return buf;
+}
+
+bool finite(const glm::dvec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+}  // namespace
+
+CameraModel defaultCameraModel(const Scene& scene) {
+  // Bounding sphere: the centre and half diagonal of the world bounds.
+  glm::dvec3 centre(0.0);
+  double radius = 1.0;
+  if (!scene.bounds.empty()) {
+    centre = 0.5 * (scene.bounds.lo + scene.bounds.hi);
+    radius = 0.5 * glm::length(scene.bounds.hi - scene.bounds.lo);
+    if (!(radius > 0.0)) radius = 1.0;  // a single point: any distance shows it
+  }
+  CameraModel model;
+  model.projection = Projection::Perspective;
+  model.yfov = 45.0 * kPi / 180.0;
+  // The sphere just fits the vertical field of view at this distance.
+  const double distance = radius / std::sin(0.5 * model.yfov);
+  model.znear = distance / 1000.0;
+  model.zfar = std::numeric_limits<double>::infinity();
+  model.worldFromCamera = glm::translate(glm::dmat4(1.0), centre + glm::dvec3(0.0, 0.0, distance));
+  model.origin = "default";
+  return model;
+}
+
+glm::dvec2 Camera::ndcScale() const {
+  if (projection == Projection::Orthographic) return {xmag, ymag};
+  const double t = std::tan(0.5 * yfov);
+  return {t * aspect, t};
+}
+
+Ray Camera::primaryRay(glm::dvec2 image) const {
+  const glm::dvec2 ndc = ndcFromImage(image);
+  const glm::dvec2 scale = ndcScale();
+  Ray ray;
+  if (projection == Projection::Orthographic) {
+    ray.origin = glm::dvec3(worldFromView * glm::dvec4(ndc.x * scale.x, ndc.y * scale.y, 0.0, 1.0));
+    ray.direction = forward();
+    ray.depthPerT = 1.0;
+    ray.tNear = znear;
+    ray.tFar = zfar;
+    return ray;
+  }
+  // The point on the view plane at depth 1; its length converts depth to t.
+  const glm::dvec3 viewDir(ndc.x * scale.x, ndc.y * scale.y, -1.0);
+  const double length = glm::length(viewDir);
+  ray.origin = eye();
+  ray.direction = glm::normalize(glm::dvec3(worldFromView * glm::dvec4(viewDir, 0.0)));
+  ray.depthPerT = 1.0 / length;
+  ray.tNear = znear * length;
+  ray.tFar = zfar * length;  // inf stays inf
+  return ray;
+}
+
+std::string Camera::describe() const {
+  char buf[512];
+  if (projection == Projection::Perspective)
+    std::snprintf(buf, sizeof buf, "perspective yfov %.4g deg aspect %.4g znear %.6g zfar %.6g",
+                  yfov * 180.0 / kPi, aspect, znear, zfar);
+  else
+    std::snprintf(buf, sizeof buf, "orthographic xmag %.6g ymag %.6g znear %.6g zfar %.6g", xmag,
+                  ymag, znear, zfar);
+  return std::string(buf) + " eye " + fmt(eye()) + " forward " + fmt(forward()) + " [" + origin +
+         "]";
+}
+
+Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int width, int height) {
+  if (width < 1 || height < 1)
+    badOption("--size", "image size " + std::to_string(width) + "x" + std::to_string(height) +
+                            " must be at least 1x1");
+  const CameraModel model = scene.camera ? *scene.camera : defaultCameraModel(scene);
+
+  Camera camera;
+  camera.projection = model.projection;
+  camera.width = width;
+  camera.height = height;
+  camera.yfov = model.yfov;
+  camera.aspect = model.aspectRatio > 0.0 ? model.aspectRatio : double(width) / double(height);
+  camera.xmag = model.xmag;
+  camera.ymag = model.ymag;
+  camera.znear = model.znear;
+  camera.zfar = model.zfar;
+  camera.origin = model.origin;
+
+  // Orientation: the model's, unless eye/target/up say otherwise. The
+  // model matrix may carry scale; only its rotation and position are used.
+  glm::dvec3 eye(model.worldFromCamera[3]);
+  glm::dvec3 forward = -glm::normalize(glm::dvec3(model.worldFromCamera[2]));
+  glm::dvec3 up = glm::normalize(glm::dvec3(model.worldFromCamera[1]));
+  glm::dvec3 right = glm::normalize(glm::dvec3(model.worldFromCamera[0]));
+  bool reorient = false;
+  if (overrides.eye) {
+    if (!finite(*overrides.eye)) badOption("--eye", "must be finite");
+    eye = *overrides.eye;
+    camera.origin += ", --eye";
+  }
+  if (overrides.target) {
+    if (!finite(*overrides.target)) badOption("--target", "must be finite");
+    const glm::dvec3 d = *overrides.target - eye;
+    if (!(glm::length(d) > 0.0)) badOption("--target", "equals the eye position " + fmt(eye));
+    forward = glm::normalize(d);
+    reorient = true;
+    camera.origin += ", --target";
+  }
+  if (overrides.up) {
+    if (!finite(*overrides.up) || !(glm::length(*overrides.up) > 0.0))
+      badOption("--up", "must be a finite non-zero vector");
+    up = glm::normalize(*overrides.up);
+    reorient = true;
+    camera.origin += ", --up";
+  }
+  if (reorient) {
+    const glm::dvec3 r = glm::cross(forward, up);
+    if (!(glm::length(r) > 1e-9)) badOption("--up", "is parallel to the view direction " + fmt(forward));
+    right = glm::normalize(r);
+    up = glm::cross(right, forward);
+  } else {
+    // Re-orthonormalise the file's rotation (it may carry scale or shear).
+    right = glm::normalize(glm::cross(forward, up));
+    up = glm::cross(right, forward);
+  }
+  camera.worldFromView = glm::dmat4(glm::dvec4(right, 0.0), glm::dvec4(up, 0.0),
+                                    glm::dvec4(-forward, 0.0), glm::dvec4(eye, 1.0));
+  camera.viewFromWorld = glm::inverse(camera.worldFromView);
+
+  if (overrides.yfovDegrees) {
+    if (camera.projection != Projection::Perspective)
+      badOption("--yfov", "the camera is orthographic");
+    const double deg = *overrides.yfovDegrees;
+    if (!(deg > 0.0 && deg < 180.0)) badOption("--yfov", "must lie in (0, 180) degrees");
+    camera.yfov = deg * kPi / 180.0;
+    camera.origin += ", --yfov";
+  }
+  if (overrides.znear) {
+    camera.znear = *overrides.znear;
+    camera.origin += ", --znear";
+  }
+  if (overrides.zfar) {
+    camera.zfar = *overrides.zfar;
+    camera.origin += ", --zfar";
+  }
+  if (camera.projection == Projection::Perspective && !(camera.znear > 0.0 && std::isfinite(camera.znear)))
+    badOption("--znear", "znear " + std::to_string(camera.znear) + " must be finite and > 0");
+  if (camera.projection == Projection::Orthographic &&
+      !(camera.znear >= 0.0 && std::isfinite(camera.znear)))
+    badOption("--znear", "znear must be finite and >= 0 for an orthographic camera");
+  if (!(camera.zfar > camera.znear))
+    badOption("--zfar", "zfar must be greater than znear");
+  if (camera.projection == Projection::Orthographic && !std::isfinite(camera.zfar))
+    badOption("--zfar", "an orthographic camera needs a finite zfar");
+  return camera;
+}
+
+}  // namespace rastray

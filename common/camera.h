@@ -1,0 +1,82 @@
+// The camera both renderers use (SPEC §2, §3): the file's camera or the
+// default one, with the command-line overrides applied, bound to an image
+// size.
+//
+// Image positions are in pixels from the image's top-left corner, y down
+// (SPEC §3). NDC: x right, y up, both in [-1, 1] over the image. View space
+// is the glTF camera space: looking down −Z, +Y up; view depth (the Z
+// output, SPEC §4) is −z_view.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "common/scene.h"
+
+namespace rastray {
+
+struct CameraOverrides {
+  std::optional<glm::dvec3> eye;
+  std::optional<glm::dvec3> target;
+  std::optional<glm::dvec3> up;
+  std::optional<double> yfovDegrees;
+  std::optional<double> znear;
+  std::optional<double> zfar;  // may be +inf
+};
+
+// A ray in world space. direction is unit length. The ray's segment
+// [tNear, tFar] lies between the near and far planes, so a ray caster that
+// starts at tNear clips exactly where the rasterizer does.
+struct Ray {
+  glm::dvec3 origin{0.0};
+  glm::dvec3 direction{0.0, 0.0, -1.0};
+  double tNear = 0.0;
+  double tFar = 0.0;
+  double depthPerT = 1.0;  // view depth of origin + t·direction is t · depthPerT (+ 0 at origin)
+};
+
+struct Camera {
+  Projection projection = Projection::Perspective;
+  int width = 0, height = 0;
+  double yfov = 0.0;    // radians (perspective)
+  double aspect = 1.0;  // the file's aspectRatio, else width / height
+  double xmag = 1.0, ymag = 1.0;  // orthographic half extents
+  double znear = 0.0, zfar = 0.0; // zfar may be +inf (perspective only)
+  glm::dmat4 worldFromView{1.0};
+  glm::dmat4 viewFromWorld{1.0};
+  std::string origin;  // where the camera came from, for `info` and reports
+
+  glm::dvec3 eye() const { return glm::dvec3(worldFromView[3]); }
+  glm::dvec3 forward() const { return -glm::normalize(glm::dvec3(worldFromView[2])); }
+
+  // NDC of an image position (pixels from the top-left corner, y down).
+  glm::dvec2 ndcFromImage(glm::dvec2 image) const {
+    return {2.0 * image.x / width - 1.0, 1.0 - 2.0 * image.y / height};
+  }
+  glm::dvec2 imageFromNdc(glm::dvec2 ndc) const {
+    return {(ndc.x + 1.0) * 0.5 * width, (1.0 - ndc.y) * 0.5 * height};
+  }
+  // Half extents of the view volume at view depth 1 (perspective) or
+  // everywhere (orthographic): x_ndc = x_view / (scale.x · depth) etc.
+  glm::dvec2 ndcScale() const;
+
+  // The primary ray through an image position.
+  Ray primaryRay(glm::dvec2 image) const;
+
+  // One line, e.g. "perspective yfov 45.0° aspect 1.333 znear 0.01 zfar inf
+  // eye (0, 1, 5) forward (0, 0, -1) [node 2 'Camera' (camera 0)]".
+  std::string describe() const;
+};
+
+// The default camera of SPEC §2 for a scene (used when it has none).
+CameraModel defaultCameraModel(const Scene& scene);
+
+// Binds the scene's camera (or the default) to an image size and applies
+// the overrides. Throws InputError (file "command line") for impossible
+// settings: znear <= 0, zfar <= znear, yfov outside (0°, 180°), eye equal
+// to target, up parallel to the view direction, or a size below 1×1.
+Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int width, int height);
+
+}  // namespace rastray

@@ -1,0 +1,38 @@
+// Errors that carry where they came from.
+//
+// Bad input (a malformed scene file, an impossible option) raises an
+// InputError naming the file and the offending element; the command line
+// turns it into one line on stderr and exit status 2 (SPEC §7).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace rastray {
+
+class InputError : public std::runtime_error {
+ public:
+  // what() reads "FILE: ELEMENT: MESSAGE" (ELEMENT may be empty, e.g. for
+  // a file that cannot be opened at all).
+  InputError(std::string file, std::string element, std::string message);
+
+  const std::string& file() const { return file_; }
+  const std::string& element() const { return element_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  std::string file_, element_, message_;
+};
+
+// Internal invariant check that prints the values involved; on in every
+// build (Release keeps assertions), because a wrong image is worse than a
+// stopped one.
+[[noreturn]] void checkFailed(const char* expr, const char* file, int line,
+                              const std::string& detail);
+
+#define RASTRAY_CHECK(cond, detail)                                   \
+  do {                                                                \
+    if (!(cond)) ::rastray::checkFailed(#cond, __FILE__, __LINE__, (detail)); \
+  } while (0)
+
+}  // namespace rastray

@@ -1,0 +1,505 @@
+#include "common/image.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <memory>
+
+#include <OpenImageIO/deepdata.h>
+#include <OpenImageIO/imageio.h>
+
+#include "common/error.h"
+#include "common/scene.h"
+
+namespace rastray {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The channel layout of every EXR we write (SPEC §6).
+const char* const kR = "R";
+const char* const kG = "G";
+const char* const kB = "B";
+const char* const kA = "A";
+const char* const kZ = "Z";
+const char* const kInstance = "id.instance";
+const char* const kTriangle = "id.triangle";
+const char* const kSample = "id.sample";
+
+std::string lowercaseExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+// "<dir>/<stem>.tmp.<pid>.<counter><ext>": beside the target (so the rename
+// stays within one file system and is atomic), unique per process and call,
+// and still ending in the real extension.
+std::string temporaryPathFor(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  const std::filesystem::path target(path);
+  const std::string name = target.stem().string() + ".tmp." + std::to_string(::getpid()) + "." +
+                           std::to_string(counter++) + target.extension().string();
+  return (target.parent_path() / name).string();
+}
+
+// Opens a temporary file beside `path` with the OIIO plugin `format`, lets
+// `writePixels` fill it, closes it and renames it over `path`. On any
+// failure the temporary file is removed and InputError names `path`.
+void writeAtomically(const std::string& path, const char* format, const OIIO::ImageSpec& spec,
+                     const std::function<bool(OIIO::ImageOutput&)>& writePixels) {
+  const std::string tmp = temporaryPathFor(path);
+  std::string error;
+  try {
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(format);
+    if (!out) {
+      error = OIIO::geterror();
+    } else if (!out->open(tmp, spec) || !writePixels(*out) || !out->close()) {
+      error = out->geterror();
+    }
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
+  }
+  // The ImageOutput is gone (and its file closed) before we rename or remove.
+  if (error.empty() && std::rename(tmp.c_str(), path.c_str()) != 0) {
+    error = std::string("cannot rename the temporary file into place: ") + std::strerror(errno);
+  }
+  if (!error.empty()) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "", "cannot write: " + error);
+  }
+}
+
+// NaN and negatives to 0, above 1 to 1.
+float unitClamp(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
+
+// [0, 1] to 0..255, rounding to nearest (ties up).
+uint8_t toByte(float unit) { return uint8_t(unit * 255.0f + 0.5f); }
+
+void checkFlat(const FlatImage& image) {
+  const size_t n = size_t(image.width) * size_t(image.height);
+  RASTRAY_CHECK(image.width >= 0 && image.height >= 0 && image.color.size() == n &&
+                    image.depth.size() == n && image.instance.size() == n &&
+                    image.triangle.size() == n,
+                "FlatImage " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                    " with " + std::to_string(image.color.size()) + " colours");
+}
+
+// ---- Reading -------------------------------------------------------------
+
+std::unique_ptr<OIIO::ImageInput> openExr(const std::string& path) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path);
+  if (!in) throw InputError(path, "", "cannot read: " + OIIO::geterror());
+  if (std::strcmp(in->format_name(), "openexr") != 0) {
+    throw InputError(path, "", std::string("not an OpenEXR file (") + in->format_name() + ")");
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.depth != 1 || spec.width <= 0 || spec.height <= 0) {
+    throw InputError(path, "", "unsupported data window (volume or empty)");
+  }
+  return in;
+}
+
+int findChannel(const OIIO::ImageSpec& spec, const char* name) {
+  return spec.channelindex(name);
+}
+
+int requireChannel(const std::string& path, const OIIO::ImageSpec& spec, const char* name) {
+  const int c = findChannel(spec, name);
+  if (c < 0) {
+    std::string have;
+    for (const std::string& n : spec.channelnames) have += (have.empty() ? "" : " ") + n;
+    throw InputError(path, std::string("channel ") + name, "missing (the file has: " + have + ")");
+  }
+  return c;
+}
+
+// Where the data window lies in the display window. Our own files have
+// them equal; other renderers may crop (e.g. to the non-empty region). The
+// image we return covers the display window; pixels outside the data
+// window read as "nothing here".
+struct Windows {
+  int width, height;        // display window
+  int dataX, dataY;         // data window origin relative to the display window
+  int dataWidth, dataHeight;
+};
+
+Windows windowsOf(const OIIO::ImageSpec& spec) {
+  Windows w;
+  w.dataWidth = spec.width;
+  w.dataHeight = spec.height;
+  if (spec.full_width > 0 && spec.full_height > 0) {
+    w.width = spec.full_width;
+    w.height = spec.full_height;
+    w.dataX = spec.x - spec.full_x;
+    w.dataY = spec.y - spec.full_y;
+  } else {
+    w.width = spec.width;
+    w.height = spec.height;
+    w.dataX = w.dataY = 0;
+  }
+  return w;
+}
+
+std::string pixelName(int x, int y) {
+  return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+}
+
+// Other renderers may store IDs as half or float. We take them when the
+// value is an integer in uint32 range; 2^32 is what 0xFFFFFFFF rounds to in
+// float, so it reads as kNoId. (Float is exact only up to 2^24: larger IDs
+// may already have been rounded by the writer, which we cannot detect.)
+bool idFromReal(double v, uint32_t& id) {
+  if (v == 4294967296.0) {
+    id = kNoId;
+    return true;
+  }
+  if (!(v >= 0.0 && v <= 4294967295.0) || v != std::floor(v)) return false;
+  id = uint32_t(v);
+  return true;
+}
+
+[[noreturn]] void badId(const std::string& path, const char* channel, double v, int x, int y) {
+  char value[64];
+  std::snprintf(value, sizeof value, "%.17g", v);
+  throw InputError(path, std::string("channel ") + channel,
+                   std::string("value ") + value + " at " + pixelName(x, y) + " is not an integer id");
+}
+
+// Reads one channel of the native pixel buffer into `dst` (one value every
+// dstStride bytes), converting with OIIO.
+void convertChannel(const OIIO::ImageSpec& spec, const std::vector<char>& native, int c,
+                    OIIO::TypeDesc dstType, void* dst, OIIO::stride_t dstStride) {
+  size_t offset = 0;
+  for (int k = 0; k < c; ++k) offset += spec.channelformat(k).size();
+  const OIIO::stride_t pixelBytes = OIIO::stride_t(spec.pixel_bytes(true));
+  OIIO::convert_image(1, spec.width, spec.height, 1, native.data() + offset, spec.channelformat(c),
+                      pixelBytes, pixelBytes * spec.width, OIIO::AutoStride, dst, dstType,
+                      dstStride, dstStride * spec.width, OIIO::AutoStride);
+}
+
+// IDs: UINT channels are copied bit for bit (OIIO would otherwise scale
+// integers as normalized values); half/float go through idFromReal.
+void readIdChannel(const std::string& path, const OIIO::ImageSpec& spec,
+                   const std::vector<char>& native, const char* name,
+                   std::vector<uint32_t>& ids) {
+  const int c = findChannel(spec, name);
+  if (c < 0) return;  // stays kNoId
+  const OIIO::TypeDesc type = spec.channelformat(c);
+  if (type.basetype == OIIO::TypeDesc::UINT32) {
+    convertChannel(spec, native, c, OIIO::TypeUInt32, ids.data(), sizeof(uint32_t));
+    return;
+  }
+  if (type.basetype != OIIO::TypeDesc::HALF && type.basetype != OIIO::TypeDesc::FLOAT &&
+      type.basetype != OIIO::TypeDesc::DOUBLE) {
+    throw InputError(path, std::string("channel ") + name,
+                     std::string("stored as ") + type.c_str() + "; expected uint, half or float");
+  }
+  std::vector<double> real(ids.size());
+  convertChannel(spec, native, c, OIIO::TypeDesc::DOUBLE, real.data(), sizeof(double));
+  for (size_t i = 0; i < ids.size(); ++i) {
+    if (!idFromReal(real[i], ids[i])) {
+      badId(path, name, real[i], int(i % size_t(spec.width)) + spec.x,
+            int(i / size_t(spec.width)) + spec.y);
+    }
+  }
+}
+
+// One ID of a deep sample; `missing` when the file has no such channel.
+uint32_t deepId(const std::string& path, const OIIO::DeepData& deep, int c, const char* name,
+                uint32_t missing, int64_t pixel, int sample, int x, int y) {
+  if (c < 0) return missing;
+  if (deep.channeltype(c).basetype == OIIO::TypeDesc::UINT32) {
+    return deep.deep_value_uint(pixel, c, sample);
+  }
+  // deep_value is exact for half and float (and would scale a uint).
+  const double v = deep.deep_value(pixel, c, sample);
+  uint32_t id = 0;
+  if (!idFromReal(v, id)) badId(path, name, v, x, y);
+  return id;
+}
+
+// Depth order with NaN last, so that sorting is well defined for any file.
+bool depthBefore(float a, float b) {
+  const bool nanA = std::isnan(a), nanB = std::isnan(b);
+  if (nanA || nanB) return !nanA && nanB;
+  return a < b;
+}
+
+bool deepSampleBefore(const DeepSample& a, const DeepSample& b) {
+  if (a.sample != b.sample) return a.sample < b.sample;
+  if (depthBefore(a.depth, b.depth)) return true;
+  if (depthBefore(b.depth, a.depth)) return false;
+  if (a.instance != b.instance) return a.instance < b.instance;
+  return a.triangle < b.triangle;
+}
+
+}  // namespace
+
+FlatImage::FlatImage(int w, int h) : width(w), height(h) {
+  RASTRAY_CHECK(w >= 0 && h >= 0, std::to_string(w) + "x" + std::to_string(h));
+  const size_t n = size_t(w) * size_t(h);
+  color.assign(n, glm::vec4(0.0f));
+  depth.assign(n, kInf);
+  instance.assign(n, kNoId);
+  triangle.assign(n, kNoId);
+}
+
+// IEC 61966-2-1, evaluated in double so that the float result is correctly
+// rounded (the 8-bit PNG quantization then never lands on the wrong side).
+float srgbToLinear(float encoded) {
+  const double v = encoded;
+  return float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+}
+
+float linearToSrgb(float linear) {
+  const double v = linear;
+  return float(v <= 0.0031308 ? v * 12.92 : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055);
+}
+
+void writeImage(const std::string& path, const FlatImage& image, ColorPrecision precision) {
+  const std::string ext = lowercaseExtension(path);
+  if (ext == ".png") {
+    writePng(path, image);
+  } else if (ext == ".exr") {
+    writeExr(path, image, precision);
+  } else {
+    throw InputError(path, "", "unknown image extension '" + ext + "' (expected .png or .exr)");
+  }
+}
+
+void writePng(const std::string& path, const FlatImage& image) {
+  checkFlat(image);
+  // Un-premultiply and encode by hand rather than with ImageBufAlgo::unpremult
+  // and colorconvert: OIIO's colour conversion follows whatever OCIO config
+  // the environment names, and unpremult keeps the colour where alpha is 0,
+  // whereas SPEC §4 wants exact sRGB and black there.
+  std::vector<uint8_t> rgba(image.color.size() * 4);
+  for (size_t i = 0; i < image.color.size(); ++i) {
+    const glm::vec4 c = image.color[i];
+    for (int k = 0; k < 3; ++k) {
+      const float straight = c.a > 0.0f ? c[k] / c.a : 0.0f;
+      rgba[4 * i + k] = toByte(linearToSrgb(unitClamp(straight)));
+    }
+    rgba[4 * i + 3] = toByte(unitClamp(c.a));
+  }
+  OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeUInt8);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  // The bytes are already straight: without this OIIO would un-premultiply
+  // them a second time.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  writeAtomically(path, "png", spec, [&](OIIO::ImageOutput& out) {
+    return out.write_image(OIIO::TypeUInt8, rgba.data());
+  });
+}
+
+void writeExr(const std::string& path, const FlatImage& image, ColorPrecision precision) {
+  checkFlat(image);
+  const OIIO::TypeDesc colorType =
+      precision == ColorPrecision::Float ? OIIO::TypeFloat : OIIO::TypeHalf;
+  OIIO::ImageSpec spec(image.width, image.height, 7, OIIO::TypeFloat);
+  spec.channelnames = {kR, kG, kB, kA, kZ, kInstance, kTriangle};
+  spec.channelformats = {colorType,       colorType,       colorType,      colorType,
+                         OIIO::TypeFloat, OIIO::TypeUInt32, OIIO::TypeUInt32};
+  spec.alpha_channel = 3;
+  spec.z_channel = 4;
+  // Lossless (not pxr24 or dwa), so Z and the IDs survive bit for bit.
+  spec.attribute("compression", "zip");
+
+  // The file's native layout: per pixel, each channel in its own format,
+  // packed. OIIO converts colour to half (round to nearest even) and copies
+  // float and uint exactly.
+  const OIIO::stride_t pixelBytes = OIIO::stride_t(spec.pixel_bytes(true));
+  const OIIO::stride_t rowBytes = pixelBytes * image.width;
+  std::vector<char> native(size_t(rowBytes) * size_t(image.height));
+  char* p = native.data();
+  const auto convert = [&](int nchannels, const void* src, OIIO::TypeDesc type,
+                           OIIO::stride_t srcStride, OIIO::TypeDesc dstType) {
+    OIIO::convert_image(nchannels, image.width, image.height, 1, src, type, srcStride,
+                        srcStride * image.width, OIIO::AutoStride, p, dstType, pixelBytes, rowBytes,
+                        OIIO::AutoStride);
+    p += nchannels * dstType.size();
+  };
+  convert(4, image.color.data(), OIIO::TypeFloat, sizeof(glm::vec4), colorType);
+  convert(1, image.depth.data(), OIIO::TypeFloat, sizeof(float), OIIO::TypeFloat);
+  convert(1, image.instance.data(), OIIO::TypeUInt32, sizeof(uint32_t), OIIO::TypeUInt32);
+  convert(1, image.triangle.data(), OIIO::TypeUInt32, sizeof(uint32_t), OIIO::TypeUInt32);
+
+  writeAtomically(path, "openexr", spec, [&](OIIO::ImageOutput& out) {
+    return out.write_image(OIIO::TypeUnknown, native.data());
+  });
+}
+
+void writeDeepExr(const std::string& path, const DeepImage& image) {
+  const size_t pixels = size_t(image.width) * size_t(image.height);
+  RASTRAY_CHECK(image.width >= 0 && image.height >= 0 && image.offsets.size() == pixels + 1 &&
+                    image.offsets.front() == 0 && image.offsets.back() == image.samples.size(),
+                "DeepImage " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                    " with " + std::to_string(image.offsets.size()) + " offsets and " +
+                    std::to_string(image.samples.size()) + " samples");
+
+  // Colour is float, not half: deep files are for sample-exact analysis.
+  OIIO::ImageSpec spec(image.width, image.height, 8, OIIO::TypeFloat);
+  spec.channelnames = {kR, kG, kB, kA, kZ, kInstance, kTriangle, kSample};
+  spec.channelformats = {OIIO::TypeFloat,  OIIO::TypeFloat,  OIIO::TypeFloat,
+                         OIIO::TypeFloat,  OIIO::TypeFloat,  OIIO::TypeUInt32,
+                         OIIO::TypeUInt32, OIIO::TypeUInt32};
+  spec.alpha_channel = 3;
+  spec.z_channel = 4;
+  spec.deep = true;
+  spec.attribute("compression", "zips");  // lossless; deep files allow none, rle, zips
+
+  OIIO::DeepData deep(spec);
+  std::vector<unsigned int> counts(pixels);
+  for (size_t i = 0; i < pixels; ++i) {
+    RASTRAY_CHECK(image.offsets[i] <= image.offsets[i + 1],
+                  "offsets[" + std::to_string(i) + "] decreases");
+    counts[i] = image.offsets[i + 1] - image.offsets[i];
+  }
+  deep.set_all_samples(counts);
+  for (size_t i = 0; i < pixels; ++i) {
+    for (uint32_t s = 0; s < counts[i]; ++s) {
+      const DeepSample& d = image.samples[image.offsets[i] + s];
+      const int64_t px = int64_t(i);
+      const int si = int(s);
+      for (int k = 0; k < 4; ++k) deep.set_deep_value(px, k, si, d.color[k]);
+      deep.set_deep_value(px, 4, si, d.depth);
+      deep.set_deep_value(px, 5, si, d.instance);
+      deep.set_deep_value(px, 6, si, d.triangle);
+      deep.set_deep_value(px, 7, si, d.sample);
+    }
+  }
+  writeAtomically(path, "openexr", spec,
+                  [&](OIIO::ImageOutput& out) { return out.write_deep_image(deep); });
+}
+
+bool isDeepExr(const std::string& path) { return openExr(path)->spec().deep; }
+
+FlatImage readExr(const std::string& path) {
+  std::unique_ptr<OIIO::ImageInput> in = openExr(path);
+  const OIIO::ImageSpec spec = in->spec();
+  // Flattening a deep file needs the sample pattern (average the per-sample
+  // composites, Z and IDs from the centre sample), which only the caller
+  // knows; so we refuse and let the caller use readDeepExr.
+  if (spec.deep) throw InputError(path, "", "deep EXR where a flat one is expected");
+  const int cR = requireChannel(path, spec, kR);
+  const int cG = requireChannel(path, spec, kG);
+  const int cB = requireChannel(path, spec, kB);
+  const int cA = findChannel(spec, kA);
+  const int cZ = findChannel(spec, kZ);
+
+  // One decode in the file's own formats; every channel is then converted
+  // from that buffer.
+  std::vector<char> native(spec.image_bytes(true));
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeUnknown, native.data())) {
+    throw InputError(path, "", "cannot read pixels: " + in->geterror());
+  }
+
+  FlatImage data(spec.width, spec.height);
+  const OIIO::stride_t colorStride = sizeof(glm::vec4);
+  float* color = &data.color[0][0];
+  convertChannel(spec, native, cR, OIIO::TypeFloat, color + 0, colorStride);
+  convertChannel(spec, native, cG, OIIO::TypeFloat, color + 1, colorStride);
+  convertChannel(spec, native, cB, OIIO::TypeFloat, color + 2, colorStride);
+  if (cA >= 0) {
+    convertChannel(spec, native, cA, OIIO::TypeFloat, color + 3, colorStride);
+  } else {
+    for (glm::vec4& c : data.color) c.a = 1.0f;
+  }
+  if (cZ >= 0) convertChannel(spec, native, cZ, OIIO::TypeFloat, data.depth.data(), sizeof(float));
+  readIdChannel(path, spec, native, kInstance, data.instance);
+  readIdChannel(path, spec, native, kTriangle, data.triangle);
+
+  const Windows w = windowsOf(spec);
+  if (w.dataX == 0 && w.dataY == 0 && w.dataWidth == w.width && w.dataHeight == w.height) {
+    return data;
+  }
+  FlatImage image(w.width, w.height);
+  for (int y = std::max(0, w.dataY); y < std::min(w.height, w.dataY + w.dataHeight); ++y) {
+    for (int x = std::max(0, w.dataX); x < std::min(w.width, w.dataX + w.dataWidth); ++x) {
+      const size_t from = data.index(x - w.dataX, y - w.dataY), to = image.index(x, y);
+      image.color[to] = data.color[from];
+      image.depth[to] = data.depth[from];
+      image.instance[to] = data.instance[from];
+      image.triangle[to] = data.triangle[from];
+    }
+  }
+  return image;
+}
+
+DeepImage readDeepExr(const std::string& path) {
+  std::unique_ptr<OIIO::ImageInput> in = openExr(path);
+  const OIIO::ImageSpec spec = in->spec();
+  if (!spec.deep) throw InputError(path, "", "flat EXR where a deep one is expected");
+  const int cR = requireChannel(path, spec, kR);
+  const int cG = requireChannel(path, spec, kG);
+  const int cB = requireChannel(path, spec, kB);
+  const int cA = findChannel(spec, kA);
+  const int cZ = findChannel(spec, kZ);
+  const int cInstance = findChannel(spec, kInstance);
+  const int cTriangle = findChannel(spec, kTriangle);
+  const int cSample = findChannel(spec, kSample);
+
+  OIIO::DeepData deep;
+  if (!in->read_native_deep_image(0, 0, deep)) {
+    throw InputError(path, "", "cannot read deep pixels: " + in->geterror());
+  }
+
+  const Windows w = windowsOf(spec);
+  DeepImage image;
+  image.width = w.width;
+  image.height = w.height;
+  image.offsets.assign(size_t(w.width) * size_t(w.height) + 1, 0);
+  // The data-window pixel that display pixel (x, y) reads, or -1.
+  const auto dataPixel = [&](int x, int y) -> int64_t {
+    const int dx = x - w.dataX, dy = y - w.dataY;
+    if (dx < 0 || dy < 0 || dx >= w.dataWidth || dy >= w.dataHeight) return -1;
+    return int64_t(dy) * w.dataWidth + dx;
+  };
+  for (int y = 0; y < w.height; ++y) {
+    for (int x = 0; x < w.width; ++x) {
+      const int64_t px = dataPixel(x, y);
+      const size_t i = size_t(y) * size_t(w.width) + size_t(x);
+      const uint64_t total = uint64_t(image.offsets[i]) + uint64_t(px < 0 ? 0 : deep.samples(px));
+      if (total > std::numeric_limits<uint32_t>::max()) {
+        throw InputError(path, "", "more than 2^32 - 1 deep samples");
+      }
+      image.offsets[i + 1] = uint32_t(total);
+    }
+  }
+  image.samples.resize(image.offsets.back());
+  for (int y = 0; y < w.height; ++y) {
+    for (int x = 0; x < w.width; ++x) {
+      const int64_t px = dataPixel(x, y);
+      if (px < 0) continue;
+      const size_t i = size_t(y) * size_t(w.width) + size_t(x);
+      DeepSample* out = image.samples.data() + image.offsets[i];
+      const int n = deep.samples(px);
+      for (int s = 0; s < n; ++s) {
+        DeepSample& d = out[s];
+        d.color = {deep.deep_value(px, cR, s), deep.deep_value(px, cG, s),
+                   deep.deep_value(px, cB, s), cA >= 0 ? deep.deep_value(px, cA, s) : 1.0f};
+        d.depth = cZ >= 0 ? deep.deep_value(px, cZ, s) : kInf;
+        d.instance = deepId(path, deep, cInstance, kInstance, kNoId, px, s, x, y);
+        d.triangle = deepId(path, deep, cTriangle, kTriangle, kNoId, px, s, x, y);
+        // Without id.sample every layer counts as sample 0.
+        d.sample = deepId(path, deep, cSample, kSample, 0, px, s, x, y);
+      }
+      // Files from other renderers need not be in our order (DeepImage).
+      std::stable_sort(out, out + n, deepSampleBefore);
+    }
+  }
+  return image;
+}
+
+}  // namespace rastray

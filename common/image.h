@@ -1,0 +1,77 @@
+// Images and per-sample AOVs, and their files (SPEC §4, §6).
+//
+// Inside rastray colour is linear RGB with premultiplied alpha. Files:
+// - PNG: sRGB-encoded, un-premultiplied, 8 bit, RGBA.
+// - EXR (flat): channels R G B A (half by default, float on request), Z
+//   (float, view depth, +inf where nothing was hit), id.instance and
+//   id.triangle (uint, 0xFFFFFFFF where nothing was hit).
+// - Deep EXR: every sample of every pixel and, with transparency, every
+//   layer, front to back; the same channels plus id.sample (uint, the
+//   sample's index in the SPEC §3 pattern) so a reader can tell samples
+//   and layers apart. Deep data are stored as OpenEXR deep scanlines.
+// Every file is written to a temporary name beside its target and renamed
+// into place, so an interrupted run never leaves a half-written output.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace rastray {
+
+// A flat frame: one colour per pixel plus the Z and IDs of the sample
+// nearest the pixel centre (SPEC §6). Row 0 is the top row.
+struct FlatImage {
+  int width = 0, height = 0;
+  std::vector<glm::vec4> color;    // linear, premultiplied
+  std::vector<float> depth;        // view depth; +inf: nothing hit
+  std::vector<uint32_t> instance;  // kNoId: nothing hit
+  std::vector<uint32_t> triangle;
+
+  FlatImage() = default;
+  FlatImage(int w, int h);  // transparent black, +inf depth, kNoId ids
+  size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
+};
+
+struct DeepSample {
+  glm::vec4 color{0.0f};  // linear, premultiplied: this layer's own contribution
+  float depth = 0.0f;     // view depth
+  uint32_t instance = 0, triangle = 0;
+  uint32_t sample = 0;    // index in the SPEC §3 sample pattern
+};
+
+// Deep frame: pixel i owns samples[offsets[i], offsets[i + 1]), sorted by
+// (sample, depth, instance, triangle): front to back within each sample.
+struct DeepImage {
+  int width = 0, height = 0;
+  std::vector<uint32_t> offsets;  // width·height + 1 entries
+  std::vector<DeepSample> samples;
+};
+
+enum class ColorPrecision { Half, Float };
+
+// Writes by extension: .png, or .exr (flat). Throws InputError (file: the
+// output path) when the extension is unknown or the file cannot be written;
+// nothing is left at the target then.
+void writeImage(const std::string& path, const FlatImage& image,
+                ColorPrecision precision = ColorPrecision::Half);
+void writePng(const std::string& path, const FlatImage& image);
+void writeExr(const std::string& path, const FlatImage& image,
+              ColorPrecision precision = ColorPrecision::Half);
+void writeDeepExr(const std::string& path, const DeepImage& image);
+
+// Readers for the compare tool; accept files from other renderers as long
+// as they carry the SPEC §6 channels (missing Z or IDs read as +inf and
+// kNoId; missing A reads as 1). Throw InputError naming the file and the
+// channel or element at fault.
+FlatImage readExr(const std::string& path);
+DeepImage readDeepExr(const std::string& path);
+bool isDeepExr(const std::string& path);
+
+// sRGB transfer functions (IEC 61966-2-1), per channel.
+float srgbToLinear(float encoded);
+float linearToSrgb(float linear);
+
+}  // namespace rastray

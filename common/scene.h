@@ -1,0 +1,197 @@
+// The shared scene model: one flattened, world-space triangle store that
+// both renderers read (SPEC §1, §2, §5). Nothing in here is specific to a
+// renderer.
+//
+// Conventions
+// - IDs: an instance is one (node with a mesh, triangle primitive) pair in
+//   depth-first scene order; a triangle ID is the triangle's index within
+//   its primitive after strip/fan triangulation. Instance i owns
+//   triangles[firstTriangle, firstTriangle + triangleCount) and
+//   vertices [firstVertex, firstVertex + vertexCount).
+// - Space: positions and normals are in world space. Positions are float
+//   (what Embree consumes); matrices are double so that flattening far
+//   from the origin adds no error beyond the final rounding to float.
+// - Winding: counter-clockwise seen from the front. When an instance's
+//   world matrix mirrors (negative determinant) the loader swaps the
+//   second and third vertex of every triangle, as glTF requires, so
+//   "CCW = front" holds in world space for every triangle in the store.
+//   Barycentrics (b1, b2) always refer to the stored vertex order.
+// - Colours: factors are linear; textures keep their sRGB-encoded bytes
+//   and are decoded by the shading module.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace rastray {
+
+// "Nothing hit" for both instance and triangle (SPEC §1).
+constexpr uint32_t kNoId = 0xFFFFFFFFu;
+
+enum class AlphaMode { Opaque, Mask, Blend };
+
+// glTF sampler, with the GL enum values the file uses (-1: unset, which
+// glTF leaves to the implementation; we treat it as linear/trilinear).
+struct TextureSampler {
+  int magFilter = -1;
+  int minFilter = -1;
+  int wrapS = 10497;  // REPEAT
+  int wrapT = 10497;
+};
+
+// A decoded image: RGBA8, sRGB-encoded colour, straight (not premultiplied)
+// alpha, row 0 at the top, which is where glTF's uv (0, 0) lies.
+struct TextureImage {
+  std::string name;
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> rgba8;
+};
+
+struct Texture {
+  int32_t image = -1;  // index into Scene::images; -1: no decodable source
+  TextureSampler sampler;
+};
+
+struct Material {
+  std::string name;
+  glm::vec4 baseColorFactor{1.0f};  // linear RGBA, straight alpha
+  int32_t baseColorTexture = -1;    // index into Scene::textures, -1: none
+  float metallic = 1.0f;
+  float roughness = 1.0f;
+  glm::vec3 emissive{0.0f};  // emissiveFactor × KHR_materials_emissive_strength
+  AlphaMode alphaMode = AlphaMode::Opaque;
+  float alphaCutoff = 0.5f;
+  bool doubleSided = false;
+  float transmission = 0.0f;  // KHR_materials_transmission
+  float ior = 1.5f;           // KHR_materials_ior
+  bool isDefault = false;     // made by the loader for primitives without a material
+
+  // SPEC §5: mirror reflection weight metallic × (1 − roughness).
+  float mirrorWeight() const { return metallic * (1.0f - roughness); }
+  bool isReflective() const { return mirrorWeight() > 0.0f; }
+  bool isRefractive() const { return transmission > 0.0f; }
+  bool isEmissive() const { return emissive != glm::vec3(0.0f); }
+};
+
+enum class LightType { Point, Spot, Directional };
+
+// KHR_lights_punctual, placed in the world by its node.
+struct Light {
+  std::string name;
+  LightType type = LightType::Point;
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;  // candela (point, spot) or lux (directional)
+  float range = 0.0f;      // 0: infinite
+  float innerConeAngle = 0.0f;
+  float outerConeAngle = 0.7853981634f;  // π/4, the glTF default
+  glm::dvec3 position{0.0};   // world space (point, spot)
+  glm::dvec3 direction{0.0, 0.0, -1.0};  // world, unit: the way light travels (node's −Z)
+  uint32_t node = 0;
+};
+
+enum class Projection { Perspective, Orthographic };
+
+// A camera as the file (or the SPEC §2 default) describes it. The image
+// size and command-line overrides are applied later (common/camera.h).
+struct CameraModel {
+  Projection projection = Projection::Perspective;
+  double yfov = 0.7853981633974483;  // radians (perspective)
+  double aspectRatio = 0.0;          // 0: use image width / height
+  double xmag = 1.0, ymag = 1.0;     // half extents (orthographic)
+  double znear = 0.1;
+  double zfar = std::numeric_limits<double>::infinity();
+  glm::dmat4 worldFromCamera{1.0};   // camera looks down −Z, +Y up
+  std::string origin;                // e.g. "node 3 'Camera' (camera 0)" or "default"
+};
+
+struct Bounds {
+  glm::dvec3 lo{std::numeric_limits<double>::infinity()};
+  glm::dvec3 hi{-std::numeric_limits<double>::infinity()};
+  bool empty() const { return !(lo.x <= hi.x); }
+  void extend(const glm::dvec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+};
+
+enum class NormalSource {
+  Authored,  // the primitive's NORMAL attribute, transformed to world space
+  Flat,      // none in the file: the geometric (face) normal, as glTF requires
+};
+
+struct Instance {
+  uint32_t node = 0;
+  uint32_t mesh = 0;
+  uint32_t primitive = 0;  // index within the mesh
+  uint32_t material = 0;   // index into Scene::materials (always valid)
+  int mode = 4;            // glTF primitive mode: 4 TRIANGLES, 5 STRIP, 6 FAN
+  glm::dmat4 worldFromObject{1.0};
+  bool mirrored = false;   // det(worldFromObject) < 0: winding was swapped
+  NormalSource normals = NormalSource::Flat;
+  bool hasTexcoords = false;  // false: texcoords are all (0, 0)
+  uint32_t firstVertex = 0, vertexCount = 0;
+  uint32_t firstTriangle = 0, triangleCount = 0;
+  uint32_t degenerateCount = 0;  // zero-area triangles (kept, cover nothing)
+};
+
+// Counts of what the file holds, for `rastray info`.
+struct SceneFileStats {
+  uint32_t nodes = 0;          // nodes in the file
+  uint32_t visitedNodes = 0;   // nodes reached from the scene's roots
+  uint32_t meshes = 0;
+  uint32_t cameras = 0;        // camera definitions in the file
+  uint32_t cameraNodes = 0;    // visited nodes that carry a camera
+  uint32_t skippedPrimitives = 0;  // points and lines: no instance number
+  int sceneIndex = -1;         // -1: no scenes, all root nodes used
+};
+
+struct Scene {
+  std::string path;  // as given by the user, used in messages
+
+  // The triangle store (see the conventions above).
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;    // unit; (0,0,0) where NormalSource::Flat
+  std::vector<glm::vec2> texcoords;  // the set the base colour texture reads
+  std::vector<glm::uvec3> triangles; // absolute indices into the vertex arrays
+  std::vector<Instance> instances;
+
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<TextureImage> images;
+  std::vector<Light> lights;
+  std::optional<CameraModel> camera;  // first camera node in walk order
+
+  Bounds bounds;  // world bounds of all instance vertices
+  SceneFileStats stats;
+
+  const Instance& instanceOf(uint32_t instance) const { return instances[instance]; }
+  // Stored vertex indices of (instance, triangle).
+  const glm::uvec3& triangle(uint32_t instance, uint32_t tri) const {
+    return triangles[instances[instance].firstTriangle + tri];
+  }
+  const Material& materialOf(uint32_t instance) const {
+    return materials[instances[instance].material];
+  }
+  size_t triangleCount() const { return triangles.size(); }
+};
+
+// Loads a .gltf (external or data-URI buffers) or .glb file. Throws
+// InputError naming the file and the element for every kind of bad input
+// (SPEC §7); never returns a partially checked scene.
+Scene loadScene(const std::string& path);
+
+// World-space geometric normal of a stored triangle (unnormalised: its
+// length is twice the area); CCW seen from the front.
+glm::dvec3 faceNormal(const Scene& scene, uint32_t instance, uint32_t tri);
+
+const char* toString(AlphaMode mode);
+const char* toString(LightType type);
+const char* toString(Projection projection);
+
+}  // namespace rastray

@@ -1,0 +1,748 @@
+// glTF 2.0 → the flattened scene of common/scene.h.
+//
+// Three steps, each refusing bad input with the element named:
+// 1. read the file; for .glb, check the container (header, chunk lengths);
+// 2. parse the JSON and check its structure (gltf_check.h): types,
+//    references, byte ranges;
+// 3. let tinygltf load the resources (buffers from data URIs, external
+//    files or the BIN chunk; images decoded by stb), then walk the scene
+//    from the checked JSON, reading accessors with bounds already proven
+//    and rejecting NaN/Inf data.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <nlohmann/json.hpp>
+#include <tiny_gltf.h>
+
+#include "common/error.h"
+#include "common/gltf_check.h"
+#include "common/scene.h"
+
+namespace rastray {
+
+namespace {
+
+using json = nlohmann::json;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
+constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
+
+uint32_t readU32(const std::vector<uint8_t>& bytes, size_t offset) {
+  uint32_t v;
+  std::memcpy(&v, bytes.data() + offset, 4);
+  return v;  // glTF is little-endian, as is every platform we build for
+}
+
+std::string firstLine(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line))
+    if (!line.empty()) return line;
+  return "unknown error";
+}
+
+// tinygltf's default ExpandFilePath is a no-op on modern versions; ours
+// states it: URIs are file names relative to the glTF file, nothing more.
+std::string expandNothing(const std::string& path, void*) { return path; }
+
+class SceneBuilder {
+ public:
+  SceneBuilder(const std::string& path, const json& doc, const tinygltf::Model& model)
+      : path_(path), doc_(doc), model_(model) {}
+
+  Scene build();
+
+ private:
+  [[noreturn]] void fail(const std::string& element, const std::string& message) const {
+    throw InputError(path_, element, message);
+  }
+  const json& array(const char* key) const {
+    static const json empty = json::array();
+    auto it = doc_.find(key);
+    return it == doc_.end() ? empty : *it;
+  }
+  template <typename T>
+  T get(const json& obj, const char* key, T fallback) const {
+    auto it = obj.find(key);
+    return it == obj.end() ? fallback : it->get<T>();
+  }
+
+  glm::dmat4 localMatrix(size_t node) const;
+  void checkNodeGraph(std::vector<int64_t>& parent) const;
+  std::vector<size_t> rootNodes(const std::vector<int64_t>& parent);
+  void walk(const std::vector<size_t>& roots);
+  void addPrimitive(size_t node, size_t mesh, size_t primitive, const glm::dmat4& world);
+  void addCamera(size_t node, const glm::dmat4& world);
+  void addLight(size_t node, const glm::dmat4& world);
+  void loadMaterials();
+  void loadTextures();
+
+  // Reads accessor `index` as doubles (components × count), applying
+  // normalisation and sparse substitution. Ranges were checked before.
+  std::vector<double> readAccessor(int64_t index, const std::string& element,
+                                   std::initializer_list<const char*> types, size_t* components) const;
+  std::vector<uint32_t> readIndices(int64_t index, const std::string& element) const;
+
+  const std::string& path_;
+  const json& doc_;
+  const tinygltf::Model& model_;
+  Scene scene_;
+  int64_t defaultMaterial_ = -1;
+};
+
+// Component read with glTF normalisation rules (glTF 2.0 §3.11).
+double readComponent(const uint8_t* p, int64_t componentType, bool normalized) {
+  switch (componentType) {
+    case 5120: { int8_t v; std::memcpy(&v, p, 1); return normalized ? std::max(v / 127.0, -1.0) : v; }
+    case 5121: { uint8_t v; std::memcpy(&v, p, 1); return normalized ? v / 255.0 : v; }
+    case 5122: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
+    case 5123: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
+    case 5125: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? v / 4294967295.0 : v; }
+    case 5126: { float v; std::memcpy(&v, p, 4); return v; }
+    default: return 0.0;
+  }
+}
+
+size_t componentBytes(int64_t componentType) {
+  switch (componentType) {
+    case 5120: case 5121: return 1;
+    case 5122: case 5123: return 2;
+    default: return 4;
+  }
+}
+
+size_t typeComponents(const std::string& type) {
+  if (type == "SCALAR") return 1;
+  if (type == "VEC2") return 2;
+  if (type == "VEC3") return 3;
+  if (type == "VEC4") return 4;
+  if (type == "MAT2") return 4;
+  if (type == "MAT3") return 9;
+  return 16;
+}
+
+std::vector<double> SceneBuilder::readAccessor(int64_t index, const std::string& element,
+                                               std::initializer_list<const char*> types,
+                                               size_t* components) const {
+  const json& a = array("accessors")[size_t(index)];
+  const std::string ae = element + " (accessor " + std::to_string(index) + ")";
+  const std::string type = a.at("type").get<std::string>();
+  if (std::find_if(types.begin(), types.end(), [&](const char* t) { return type == t; }) == types.end())
+    fail(ae, "type " + type + " is not allowed here");
+  const int64_t componentType = a.at("componentType").get<int64_t>();
+  const bool normalized = get(a, "normalized", false);
+  const size_t count = a.at("count").get<size_t>();
+  const size_t n = typeComponents(type);
+  const size_t cbytes = componentBytes(componentType);
+  *components = n;
+  std::vector<double> out(count * n, 0.0);  // no bufferView: zeros (glTF)
+
+  auto readView = [&](int64_t view, size_t byteOffset, size_t stride, size_t elements, size_t elementComponents,
+                      int64_t ctype, bool norm, double* dst) {
+    const json& v = array("bufferViews")[size_t(view)];
+    const auto& data = model_.buffers[v.at("buffer").get<size_t>()].data;
+    const size_t base = get<size_t>(v, "byteOffset", 0) + byteOffset;
+    for (size_t e = 0; e < elements; ++e)
+      for (size_t c = 0; c < elementComponents; ++c)
+        dst[e * elementComponents + c] =
+            readComponent(data.data() + base + e * stride + c * componentBytes(ctype), ctype, norm);
+  };
+
+  if (a.contains("bufferView")) {
+    const int64_t view = a.at("bufferView").get<int64_t>();
+    const size_t stride = get<size_t>(array("bufferViews")[size_t(view)], "byteStride", 0);
+    readView(view, get<size_t>(a, "byteOffset", 0), stride ? stride : n * cbytes, count, n, componentType,
+             normalized, out.data());
+  }
+  if (a.contains("sparse")) {
+    const json& s = a.at("sparse");
+    const size_t sparseCount = s.at("count").get<size_t>();
+    const json& si = s.at("indices");
+    const json& sv = s.at("values");
+    std::vector<double> indices(sparseCount), values(sparseCount * n);
+    const int64_t ict = si.at("componentType").get<int64_t>();
+    readView(si.at("bufferView").get<int64_t>(), get<size_t>(si, "byteOffset", 0), componentBytes(ict),
+             sparseCount, 1, ict, false, indices.data());
+    readView(sv.at("bufferView").get<int64_t>(), get<size_t>(sv, "byteOffset", 0), n * cbytes, sparseCount,
+             n, componentType, normalized, values.data());
+    for (size_t k = 0; k < sparseCount; ++k) {
+      const double i = indices[k];
+      if (!(i < double(count)))
+        fail(ae, "sparse index " + std::to_string(uint64_t(i)) + " out of range (" + std::to_string(count) +
+                     " elements)");
+      std::copy_n(values.data() + k * n, n, out.data() + size_t(i) * n);
+    }
+  }
+  for (size_t i = 0; i < out.size(); ++i)
+    if (!std::isfinite(out[i]))
+      fail(ae, "element " + std::to_string(i / n) + " component " + std::to_string(i % n) + " is " +
+                   (std::isnan(out[i]) ? "NaN" : "infinite"));
+  return out;
+}
+
+std::vector<uint32_t> SceneBuilder::readIndices(int64_t index, const std::string& element) const {
+  const json& a = array("accessors")[size_t(index)];
+  const std::string ae = element + " (accessor " + std::to_string(index) + ")";
+  const int64_t ct = a.at("componentType").get<int64_t>();
+  if (ct != 5121 && ct != 5123 && ct != 5125)
+    fail(ae, "index componentType " + std::to_string(ct) + " must be 5121, 5123 or 5125");
+  if (get(a, "normalized", false)) fail(ae, "indices must not be normalized");
+  size_t components = 0;
+  const std::vector<double> values = readAccessor(index, element, {"SCALAR"}, &components);
+  std::vector<uint32_t> out(values.size());
+  for (size_t i = 0; i < values.size(); ++i) out[i] = uint32_t(values[i]);
+  return out;
+}
+
+glm::dmat4 SceneBuilder::localMatrix(size_t node) const {
+  const json& n = array("nodes")[node];
+  if (n.contains("matrix")) {
+    std::vector<double> m = n.at("matrix").get<std::vector<double>>();
+    return glm::make_mat4(m.data());  // glTF matrices are column-major, as GLM's
+  }
+  glm::dmat4 result(1.0);
+  if (n.contains("translation")) {
+    const auto t = n.at("translation").get<std::vector<double>>();
+    result = glm::translate(result, glm::dvec3(t[0], t[1], t[2]));
+  }
+  if (n.contains("rotation")) {
+    const auto r = n.at("rotation").get<std::vector<double>>();
+    glm::dquat q(r[3], r[0], r[1], r[2]);  // glTF stores (x, y, z, w)
+    const double length = glm::length(q);
+    if (!(length > 0.0)) fail("node " + std::to_string(node), "\"rotation\" is a zero quaternion");
+    result = result * glm::mat4_cast(q / length);  // exporters round: renormalise
+  }
+  if (n.contains("scale")) {
+    const auto s = n.at("scale").get<std::vector<double>>();
+    result = glm::scale(result, glm::dvec3(s[0], s[1], s[2]));
+  }
+  return result;
+}
+
+void SceneBuilder::checkNodeGraph(std::vector<int64_t>& parent) const {
+  const json& nodes = array("nodes");
+  parent.assign(nodes.size(), -1);
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (!nodes[i].contains("children")) continue;
+    for (const json& c : nodes[i].at("children")) {
+      const size_t child = c.get<size_t>();
+      if (child == i) fail("node " + std::to_string(i), "lists itself as a child (cycle)");
+      if (parent[child] >= 0)
+        fail("node " + std::to_string(child), "is a child of both node " + std::to_string(parent[child]) +
+                                                  " and node " + std::to_string(i) +
+                                                  " (glTF nodes form trees)");
+      parent[child] = int64_t(i);
+    }
+  }
+  // With one parent per node, a cycle is a parent chain that never ends:
+  // follow each chain, marking nodes by the walk that reached them.
+  std::vector<size_t> seenBy(nodes.size(), SIZE_MAX);
+  for (size_t start = 0; start < nodes.size(); ++start) {
+    size_t i = start;
+    while (parent[i] >= 0 && seenBy[i] == SIZE_MAX) {
+      seenBy[i] = start;
+      i = size_t(parent[i]);
+      if (seenBy[i] == start)
+        fail("node " + std::to_string(i), "is its own ancestor (cycle in the node graph)");
+    }
+  }
+}
+
+std::vector<size_t> SceneBuilder::rootNodes(const std::vector<int64_t>& parent) {
+  const json& scenes = array("scenes");
+  std::vector<size_t> roots;
+  if (scenes.empty()) {
+    // No scenes: every root node, in index order (SPEC §1).
+    scene_.stats.sceneIndex = -1;
+    for (size_t i = 0; i < parent.size(); ++i)
+      if (parent[i] < 0) roots.push_back(i);
+    return roots;
+  }
+  const size_t index = get<size_t>(doc_, "scene", 0);
+  scene_.stats.sceneIndex = int(index);
+  const json& s = scenes[index];
+  const std::string e = "scene " + std::to_string(index);
+  std::vector<bool> listed(parent.size(), false);
+  if (s.contains("nodes")) {
+    for (const json& n : s.at("nodes")) {
+      const size_t node = n.get<size_t>();
+      if (parent[node] >= 0)
+        fail(e, "node " + std::to_string(node) + " is not a root node (child of node " +
+                    std::to_string(parent[node]) + ")");
+      if (listed[node]) fail(e, "lists node " + std::to_string(node) + " twice");
+      listed[node] = true;
+      roots.push_back(node);
+    }
+  }
+  return roots;
+}
+
+void SceneBuilder::walk(const std::vector<size_t>& roots) {
+  // Depth-first, children in order, with an explicit stack: a deep
+  // hierarchy must not overflow the call stack.
+  struct Item {
+    size_t node;
+    glm::dmat4 parentWorld;
+  };
+  std::vector<Item> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
+  const json& nodes = array("nodes");
+  while (!stack.empty()) {
+    const Item item = stack.back();
+    stack.pop_back();
+    const json& n = nodes[item.node];
+    const glm::dmat4 world = item.parentWorld * localMatrix(item.node);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!std::isfinite(world[c][r]))
+          fail("node " + std::to_string(item.node), "world matrix is not finite");
+    ++scene_.stats.visitedNodes;
+    if (n.contains("mesh")) {
+      const size_t mesh = n.at("mesh").get<size_t>();
+      const json& prims = array("meshes")[mesh].at("primitives");
+      for (size_t p = 0; p < prims.size(); ++p) {
+        const int64_t mode = get<int64_t>(prims[p], "mode", 4);
+        if (mode < 4) {
+          ++scene_.stats.skippedPrimitives;  // points and lines: no instance number
+          continue;
+        }
+        addPrimitive(item.node, mesh, p, world);
+      }
+    }
+    if (n.contains("camera")) addCamera(item.node, world);
+    if (n.contains("extensions") && n.at("extensions").contains("KHR_lights_punctual"))
+      addLight(item.node, world);
+    if (n.contains("children")) {
+      const json& children = n.at("children");
+      for (auto it = children.rbegin(); it != children.rend(); ++it)
+        stack.push_back({it->get<size_t>(), world});
+    }
+  }
+}
+
+void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, const glm::dmat4& world) {
+  const json& prim = array("meshes")[mesh].at("primitives")[primitive];
+  const std::string e = "mesh " + std::to_string(mesh) + " primitive " + std::to_string(primitive);
+  const json& attributes = prim.at("attributes");
+
+  if (scene_.instances.size() >= kNoId - 1) fail(e, "too many instances");
+  Instance inst;
+  inst.node = uint32_t(node);
+  inst.mesh = uint32_t(mesh);
+  inst.primitive = uint32_t(primitive);
+  inst.mode = int(get<int64_t>(prim, "mode", 4));
+  inst.worldFromObject = world;
+  inst.mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+  if (prim.contains("material")) {
+    inst.material = prim.at("material").get<uint32_t>();
+  } else {
+    if (defaultMaterial_ < 0) {
+      Material m;
+      m.name = "default";
+      m.isDefault = true;
+      defaultMaterial_ = int64_t(scene_.materials.size());
+      scene_.materials.push_back(m);
+    }
+    inst.material = uint32_t(defaultMaterial_);
+  }
+  inst.firstVertex = uint32_t(scene_.positions.size());
+  inst.firstTriangle = uint32_t(scene_.triangles.size());
+
+  // No POSITION: the primitive keeps its instance number and draws nothing.
+  if (!attributes.contains("POSITION")) {
+    scene_.instances.push_back(inst);
+    return;
+  }
+  size_t components = 0;
+  const int64_t posAccessor = attributes.at("POSITION").get<int64_t>();
+  const std::vector<double> pos = readAccessor(posAccessor, e + " POSITION", {"VEC3"}, &components);
+  const size_t vertexCount = pos.size() / 3;
+  if (scene_.positions.size() + vertexCount >= size_t(kNoId))
+    fail(e, "the scene has more than 2^32 vertices");
+
+  std::vector<double> nrm, uv;
+  if (attributes.contains("NORMAL")) {
+    nrm = readAccessor(attributes.at("NORMAL").get<int64_t>(), e + " NORMAL", {"VEC3"}, &components);
+    if (nrm.size() != pos.size())
+      fail(e, "NORMAL has " + std::to_string(nrm.size() / 3) + " elements, POSITION " +
+                  std::to_string(vertexCount));
+    inst.normals = NormalSource::Authored;
+  }
+  // The texcoord set the base colour texture reads (TEXCOORD_0 unless it says otherwise).
+  int64_t texCoordSet = 0;
+  {
+    const json& mats = array("materials");
+    if (prim.contains("material")) {
+      const json& m = mats[prim.at("material").get<size_t>()];
+      if (m.contains("pbrMetallicRoughness") && m.at("pbrMetallicRoughness").contains("baseColorTexture"))
+        texCoordSet = get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0);
+    }
+  }
+  const std::string uvName = "TEXCOORD_" + std::to_string(texCoordSet);
+  if (attributes.contains(uvName)) {
+    uv = readAccessor(attributes.at(uvName).get<int64_t>(), e + " " + uvName, {"VEC2"}, &components);
+    if (uv.size() / 2 != vertexCount)
+      fail(e, uvName + " has " + std::to_string(uv.size() / 2) + " elements, POSITION " +
+                  std::to_string(vertexCount));
+    inst.hasTexcoords = true;
+  }
+
+  // Normals transform by the cofactor matrix: the inverse transpose scaled
+  // by the determinant, defined even for singular matrices; the sign keeps
+  // normals on the same side for mirroring transforms.
+  const glm::dmat3 m3(world);
+  const glm::dmat3 cofactor(glm::cross(m3[1], m3[2]), glm::cross(m3[2], m3[0]), glm::cross(m3[0], m3[1]));
+  const double sign = inst.mirrored ? -1.0 : 1.0;
+  for (size_t v = 0; v < vertexCount; ++v) {
+    const glm::dvec3 p = glm::dvec3(world * glm::dvec4(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2], 1.0));
+    const glm::vec3 pf(p);
+    if (!std::isfinite(pf.x) || !std::isfinite(pf.y) || !std::isfinite(pf.z))
+      fail(e + " POSITION (accessor " + std::to_string(posAccessor) + ")",
+           "vertex " + std::to_string(v) + " is not finite in world space as float");
+    scene_.positions.push_back(pf);
+    scene_.bounds.extend(glm::dvec3(pf));
+    glm::dvec3 n(0.0);
+    if (!nrm.empty()) {
+      n = sign * (cofactor * glm::dvec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]));
+      const double len = glm::length(n);
+      n = len > 0.0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);  // zero: use the face normal
+    }
+    scene_.normals.emplace_back(n);
+    scene_.texcoords.emplace_back(uv.empty() ? glm::vec2(0.0f) : glm::vec2(float(uv[2 * v]), float(uv[2 * v + 1])));
+  }
+  inst.vertexCount = uint32_t(vertexCount);
+
+  // Triangulate (SPEC §1).
+  std::vector<uint32_t> indices;
+  if (prim.contains("indices")) {
+    const int64_t ia = prim.at("indices").get<int64_t>();
+    indices = readIndices(ia, e + " indices");
+    for (uint32_t i : indices)
+      if (i >= vertexCount)
+        fail("accessor " + std::to_string(ia), "index " + std::to_string(i) + " out of range (" +
+                                                   std::to_string(vertexCount) + " vertices)");
+  } else {
+    indices.resize(vertexCount);
+    for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
+  }
+  const size_t n = indices.size();
+  std::vector<glm::uvec3> tris;
+  if (inst.mode == 4) {
+    if (n % 3 != 0)
+      fail(e, std::to_string(n) + (prim.contains("indices") ? " indices" : " vertices") +
+                  " for TRIANGLES is not a multiple of 3");
+    for (size_t i = 0; i + 2 < n; i += 3) tris.emplace_back(indices[i], indices[i + 1], indices[i + 2]);
+  } else if (inst.mode == 5) {
+    for (size_t i = 0; i + 2 < n; ++i)
+      tris.push_back(i % 2 == 0 ? glm::uvec3(indices[i], indices[i + 1], indices[i + 2])
+                                : glm::uvec3(indices[i + 1], indices[i], indices[i + 2]));
+  } else {
+    for (size_t i = 0; i + 2 < n; ++i) tris.emplace_back(indices[0], indices[i + 1], indices[i + 2]);
+  }
+  if (scene_.triangles.size() + tris.size() >= size_t(kNoId)) fail(e, "the scene has more than 2^32 triangles");
+  for (glm::uvec3 t : tris) {
+    if (inst.mirrored) std::swap(t.y, t.z);  // keep CCW = front in world space
+    t += glm::uvec3(inst.firstVertex);
+    const glm::dvec3 a(scene_.positions[t.x]), b(scene_.positions[t.y]), c(scene_.positions[t.z]);
+    if (glm::cross(b - a, c - a) == glm::dvec3(0.0)) ++inst.degenerateCount;
+    scene_.triangles.push_back(t);
+  }
+  inst.triangleCount = uint32_t(tris.size());
+  scene_.instances.push_back(inst);
+}
+
+void SceneBuilder::addCamera(size_t node, const glm::dmat4& world) {
+  ++scene_.stats.cameraNodes;
+  if (scene_.camera) return;  // the first camera node in walk order wins (SPEC §2)
+  const size_t index = array("nodes")[node].at("camera").get<size_t>();
+  const json& c = array("cameras")[index];
+  const std::string e = "node " + std::to_string(node);
+  if (glm::length(glm::cross(glm::dvec3(world[0]), glm::dvec3(world[1]))) == 0.0 ||
+      glm::length(glm::dvec3(world[2])) == 0.0)
+    fail(e, "the camera's world matrix is singular");
+  CameraModel cam;
+  cam.worldFromCamera = world;
+  if (c.at("type") == "perspective") {
+    const json& p = c.at("perspective");
+    cam.projection = Projection::Perspective;
+    cam.yfov = p.at("yfov").get<double>();
+    cam.znear = p.at("znear").get<double>();
+    cam.zfar = get(p, "zfar", std::numeric_limits<double>::infinity());
+    cam.aspectRatio = get(p, "aspectRatio", 0.0);
+  } else {
+    const json& o = c.at("orthographic");
+    cam.projection = Projection::Orthographic;
+    cam.xmag = std::abs(o.at("xmag").get<double>());
+    cam.ymag = std::abs(o.at("ymag").get<double>());
+    cam.znear = o.at("znear").get<double>();
+    cam.zfar = o.at("zfar").get<double>();
+  }
+  const std::string name = get<std::string>(array("nodes")[node], "name", "");
+  cam.origin = "node " + std::to_string(node) + (name.empty() ? "" : " '" + name + "'") + " (camera " +
+               std::to_string(index) + ")";
+  scene_.camera = cam;
+}
+
+void SceneBuilder::addLight(size_t node, const glm::dmat4& world) {
+  const size_t index = array("nodes")[node].at("extensions").at("KHR_lights_punctual").at("light").get<size_t>();
+  const json& l = doc_.at("extensions").at("KHR_lights_punctual").at("lights")[index];
+  Light light;
+  light.name = get<std::string>(l, "name", "");
+  const std::string type = l.at("type").get<std::string>();
+  light.type = type == "point" ? LightType::Point : type == "spot" ? LightType::Spot : LightType::Directional;
+  if (l.contains("color")) {
+    const auto c = l.at("color").get<std::vector<double>>();
+    if (c[0] < 0 || c[1] < 0 || c[2] < 0) fail("light " + std::to_string(index), "\"color\" must not be negative");
+    light.color = glm::vec3(float(c[0]), float(c[1]), float(c[2]));
+  }
+  light.intensity = float(get(l, "intensity", 1.0));
+  light.range = float(get(l, "range", 0.0));
+  if (l.contains("spot")) {
+    light.innerConeAngle = float(get(l.at("spot"), "innerConeAngle", 0.0));
+    light.outerConeAngle = float(get(l.at("spot"), "outerConeAngle", kPi / 4));
+  }
+  light.position = glm::dvec3(world[3]);
+  const glm::dvec3 d = glm::dvec3(world * glm::dvec4(0.0, 0.0, -1.0, 0.0));
+  if (light.type != LightType::Point) {
+    if (!(glm::length(d) > 0.0)) fail("node " + std::to_string(node), "the light's world matrix is singular");
+    light.direction = glm::normalize(d);
+  }
+  light.node = uint32_t(node);
+  scene_.lights.push_back(light);
+}
+
+void SceneBuilder::loadTextures() {
+  // Images: tinygltf decoded them (stb); we keep RGBA8.
+  for (size_t i = 0; i < model_.images.size(); ++i) {
+    const tinygltf::Image& src = model_.images[i];
+    TextureImage img;
+    img.name = src.name;
+    img.width = src.width;
+    img.height = src.height;
+    const int comps = src.component;
+    const int bytes = src.bits / 8;
+    const size_t pixels = size_t(std::max(src.width, 0)) * size_t(std::max(src.height, 0));
+    if (src.width <= 0 || src.height <= 0 || comps < 1 || comps > 4 || (bytes != 1 && bytes != 2) ||
+        src.image.size() < pixels * size_t(comps * bytes))
+      fail("image " + std::to_string(i), "could not be decoded to 8- or 16-bit pixels");
+    img.rgba8.resize(pixels * 4);
+    for (size_t p = 0; p < pixels; ++p) {
+      uint8_t c[4] = {0, 0, 0, 255};
+      for (int k = 0; k < comps; ++k) {
+        const size_t at = (p * size_t(comps) + size_t(k)) * size_t(bytes);
+        // 16-bit: keep the high byte, rounded (65535 → 255).
+        c[k] = bytes == 1 ? src.image[at]
+                          : uint8_t((uint32_t(src.image[at]) | uint32_t(src.image[at + 1]) << 8) * 255u / 65535u);
+      }
+      if (comps == 1) c[1] = c[2] = c[0];           // grey
+      if (comps == 2) { c[3] = c[1]; c[1] = c[2] = c[0]; }  // grey + alpha
+      std::memcpy(&img.rgba8[p * 4], c, 4);
+    }
+    scene_.images.push_back(std::move(img));
+  }
+  const json& textures = array("textures");
+  for (size_t i = 0; i < textures.size(); ++i) {
+    Texture t;
+    t.image = int32_t(get<int64_t>(textures[i], "source", -1));
+    if (textures[i].contains("sampler")) {
+      const json& s = array("samplers")[textures[i].at("sampler").get<size_t>()];
+      t.sampler.magFilter = int(get<int64_t>(s, "magFilter", -1));
+      t.sampler.minFilter = int(get<int64_t>(s, "minFilter", -1));
+      t.sampler.wrapS = int(get<int64_t>(s, "wrapS", 10497));
+      t.sampler.wrapT = int(get<int64_t>(s, "wrapT", 10497));
+    }
+    scene_.textures.push_back(t);
+  }
+}
+
+void SceneBuilder::loadMaterials() {
+  const json& materials = array("materials");
+  for (size_t i = 0; i < materials.size(); ++i) {
+    const json& m = materials[i];
+    const std::string e = "material " + std::to_string(i);
+    Material mat;
+    mat.name = get<std::string>(m, "name", "");
+    auto unit = [&](double v, const char* what) {
+      if (!(v >= 0.0 && v <= 1.0)) fail(e, std::string(what) + " " + std::to_string(v) + " must lie in [0, 1]");
+      return float(v);
+    };
+    if (m.contains("pbrMetallicRoughness")) {
+      const json& pbr = m.at("pbrMetallicRoughness");
+      if (pbr.contains("baseColorFactor")) {
+        const auto f = pbr.at("baseColorFactor").get<std::vector<double>>();
+        mat.baseColorFactor = glm::vec4(unit(f[0], "baseColorFactor"), unit(f[1], "baseColorFactor"),
+                                        unit(f[2], "baseColorFactor"), unit(f[3], "baseColorFactor"));
+      }
+      if (pbr.contains("baseColorTexture")) {
+        const int32_t tex = pbr.at("baseColorTexture").at("index").get<int32_t>();
+        // A texture without an image we can decode (e.g. only a KTX2 source
+        // through an extension) is ignored: the factor alone applies.
+        if (scene_.textures[size_t(tex)].image >= 0) mat.baseColorTexture = tex;
+      }
+      mat.metallic = unit(get(pbr, "metallicFactor", 1.0), "metallicFactor");
+      mat.roughness = unit(get(pbr, "roughnessFactor", 1.0), "roughnessFactor");
+    }
+    glm::dvec3 emissive(0.0);
+    if (m.contains("emissiveFactor")) {
+      const auto f = m.at("emissiveFactor").get<std::vector<double>>();
+      emissive = glm::dvec3(unit(f[0], "emissiveFactor"), unit(f[1], "emissiveFactor"), unit(f[2], "emissiveFactor"));
+    }
+    const std::string mode = get<std::string>(m, "alphaMode", "OPAQUE");
+    mat.alphaMode = mode == "MASK" ? AlphaMode::Mask : mode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+    mat.alphaCutoff = float(get(m, "alphaCutoff", 0.5));
+    if (mat.alphaCutoff < 0.0f) fail(e, "\"alphaCutoff\" must be >= 0");
+    mat.doubleSided = get(m, "doubleSided", false);
+    if (m.contains("extensions")) {
+      const json& ext = m.at("extensions");
+      if (ext.contains("KHR_materials_transmission"))
+        mat.transmission = unit(get(ext.at("KHR_materials_transmission"), "transmissionFactor", 0.0),
+                                "transmissionFactor");
+      if (ext.contains("KHR_materials_ior")) {
+        const double ior = get(ext.at("KHR_materials_ior"), "ior", 1.5);
+        if (!(ior >= 1.0)) fail(e + " KHR_materials_ior", "\"ior\" " + std::to_string(ior) + " must be >= 1");
+        mat.ior = float(ior);
+      }
+      if (ext.contains("KHR_materials_emissive_strength")) {
+        const double s = get(ext.at("KHR_materials_emissive_strength"), "emissiveStrength", 1.0);
+        if (!(s >= 0.0)) fail(e + " KHR_materials_emissive_strength", "\"emissiveStrength\" must be >= 0");
+        emissive *= s;
+      }
+    }
+    mat.emissive = glm::vec3(emissive);
+    scene_.materials.push_back(mat);
+  }
+}
+
+Scene SceneBuilder::build() {
+  scene_.path = path_;
+  scene_.stats.nodes = uint32_t(array("nodes").size());
+  scene_.stats.meshes = uint32_t(array("meshes").size());
+  scene_.stats.cameras = uint32_t(array("cameras").size());
+  loadTextures();
+  loadMaterials();
+  std::vector<int64_t> parent;
+  checkNodeGraph(parent);
+  walk(rootNodes(parent));
+  return std::move(scene_);
+}
+
+std::vector<uint8_t> readFile(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path, "", "no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "", "not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", std::string("cannot open: ") + std::strerror(errno));
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(path, "", "read error");
+  return bytes;
+}
+
+}  // namespace
+
+Scene loadScene(const std::string& path) {
+  const std::vector<uint8_t> bytes = readFile(path);
+
+  // The container: a .glb is recognised by its magic, whatever its name.
+  GltfCheckContext context{path, false, 0};
+  std::string jsonText;
+  if (bytes.size() >= 4 && readU32(bytes, 0) == kGlbMagic) {
+    context.isGlb = true;
+    if (bytes.size() < 20) throw InputError(path, "GLB header", "file is too short (" + std::to_string(bytes.size()) + " bytes)");
+    const uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8);
+    if (version != 2) throw InputError(path, "GLB header", "version " + std::to_string(version) + " is not 2");
+    if (length != bytes.size())
+      throw InputError(path, "GLB header", "declares " + std::to_string(length) + " bytes, the file has " +
+                                               std::to_string(bytes.size()));
+    const uint32_t jsonLength = readU32(bytes, 12), jsonType = readU32(bytes, 16);
+    if (jsonType != kChunkJson) throw InputError(path, "GLB chunk 0", "is not a JSON chunk");
+    if (jsonLength > bytes.size() - 20)
+      throw InputError(path, "GLB chunk 0", "length " + std::to_string(jsonLength) + " runs past the end of the file");
+    jsonText.assign(reinterpret_cast<const char*>(bytes.data() + 20), jsonLength);
+    const size_t binAt = 20 + ((size_t(jsonLength) + 3) & ~size_t(3));
+    if (binAt + 8 <= bytes.size()) {
+      const uint32_t binLength = readU32(bytes, binAt), binType = readU32(bytes, binAt + 4);
+      if (binType == kChunkBin) {
+        if (binLength > bytes.size() - binAt - 8)
+          throw InputError(path, "GLB chunk 1", "length " + std::to_string(binLength) + " runs past the end of the file");
+        context.glbBinSize = binLength;
+      }
+    }
+  } else {
+    jsonText.assign(bytes.begin(), bytes.end());
+  }
+
+  json doc;
+  try {
+    doc = json::parse(jsonText);
+  } catch (const json::parse_error& e) {
+    std::string what = e.what();
+    const size_t at = what.find("] ");
+    throw InputError(path, "", "invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
+  }
+  checkGltfDocument(doc, context);
+
+  // Resources through tinygltf. The document is sound by now, so its
+  // remaining failures are about resources: missing files, bad data URIs,
+  // undecodable images.
+  tinygltf::TinyGLTF loader;
+  tinygltf::FsCallbacks fs{&tinygltf::FileExists, &expandNothing, &tinygltf::ReadWholeFile,
+                           &tinygltf::WriteWholeFile, nullptr};
+  loader.SetFsCallbacks(fs);
+  tinygltf::Model model;
+  std::string err, warn;
+  const std::string baseDir = std::filesystem::path(path).parent_path().string();
+  if (bytes.size() > UINT32_MAX) throw InputError(path, "", "file is larger than 4 GiB");
+  const bool ok = context.isGlb
+                      ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()),
+                                                    baseDir.empty() ? "." : baseDir)
+                      : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(), unsigned(jsonText.size()),
+                                                   baseDir.empty() ? "." : baseDir);
+  if (!ok) throw InputError(path, "", firstLine(err));
+  if (model.buffers.size() != doc.value("buffers", json::array()).size() ||
+      model.images.size() != doc.value("images", json::array()).size())
+    throw InputError(path, "", "tinygltf loaded a different number of buffers or images than the file lists");
+  for (size_t i = 0; i < model.buffers.size(); ++i)
+    if (model.buffers[i].data.size() < doc.at("buffers")[i].at("byteLength").get<size_t>())
+      throw InputError(path, "buffer " + std::to_string(i), "is shorter than its byteLength");
+
+  return SceneBuilder(path, doc, model).build();
+}
+
+glm::dvec3 faceNormal(const Scene& scene, uint32_t instance, uint32_t tri) {
+  const glm::uvec3 t = scene.triangle(instance, tri);
+  const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
+  return glm::cross(b - a, c - a);
+}
+
+const char* toString(AlphaMode mode) {
+  switch (mode) {
+    case AlphaMode::Opaque: return "OPAQUE";
+    case AlphaMode::Mask: return "MASK";
+    case AlphaMode::Blend: return "BLEND";
+  }
+  return "?";
+}
+
+const char* toString(LightType type) {
+  switch (type) {
+    case LightType::Point: return "point";
+    case LightType::Spot: return "spot";
+    case LightType::Directional: return "directional";
+  }
+  return "?";
+}
+
+const char* toString(Projection projection) {
+  return projection == Projection::Perspective ? "perspective" : "orthographic";
+}
+
+}  // namespace rastray
