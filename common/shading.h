@@ -1,0 +1,110 @@
+// The one shading model both renderers use (SPEC §5).
+//
+// For a surface point seen along direction d, with base colour C (factor ×
+// sRGB-decoded texture), mirror weight w = metallic·(1 − roughness) and
+// transmission t, the outgoing radiance is
+//
+//   L = emissive + (1 − w)(1 − t) · C/π · Σ_lights E_l · V_l · max(0, n·l)
+//       + w · C · L_reflect
+//       + t · (F · L_reflect + (1 − F) · C · L_refract)
+//
+// with F the exact dielectric Fresnel reflectance (common/optics.h), E_l
+// the light's irradiance (point and spot: intensity / distance², with
+// glTF's range window and spot cone falloff; directional: intensity) and
+// V_l the light's transmittance from the renderer (shadow rays or shadow
+// maps). Without lights, an eye light at the camera replaces the sum with
+// C · |n·d| and casts no shadows. Rough metals are treated as Lambertian in
+// C (only the mirror part reflects), so glTF's default material
+// (metallic 1, roughness 1) renders white, not black.
+//
+// A surface's layer colour is premultiplied: (L·α, α), with α the base
+// colour alpha for BLEND materials and 1 otherwise; MASK coverage is the
+// renderer's decision (alpha >= cutoff), made with `coverageAlpha`.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "common/analysis.h"
+#include "common/camera.h"
+#include "common/scene.h"
+#include "common/surface.h"
+#include "common/texture.h"
+
+namespace rastray {
+
+enum class RayKind { Primary, Shadow, Reflection, Refraction, Transparency };
+constexpr int kRayKindCount = 5;
+const char* toString(RayKind kind);
+
+// What shading asks a renderer about light visibility. Implemented with
+// shadow rays by the ray caster and with shadow maps by the rasterizer.
+class LightVisibility {
+ public:
+  virtual ~LightVisibility() = default;
+  // Per-channel fraction of the light arriving at `point` (1: unoccluded;
+  // BLEND occluders pass 1 − α, refractive ones transmission × C).
+  // `toLight` is unit, `distance` the distance to the light (+inf for
+  // directional lights).
+  virtual glm::vec3 transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
+                                  double distance) const = 0;
+};
+
+// Radiance along secondary rays: implemented by the ray caster, and used by
+// the rasterizer's shading in hybrid mode (SPEC: hybrid = rasterized
+// primary visibility + traced secondary rays).
+class SecondaryRayTracer {
+ public:
+  virtual ~SecondaryRayTracer() = default;
+  // Radiance (linear RGB) arriving at `from` along unit `direction`,
+  // composited front to back through transparent layers; black when the
+  // ray leaves the scene. `depth` is the new ray's depth (primary = 0),
+  // `throughput` the weight this radiance will be multiplied by.
+  virtual glm::vec3 radiance(const SurfacePoint& from, const glm::dvec3& direction, RayKind kind, int depth,
+                             float throughput) const = 0;
+};
+
+struct ShadingOptions {
+  int maxDepth = 8;               // secondary rays deeper than this return black
+  float minThroughput = 1e-3f;    // secondary rays with less weight are not traced
+  TextureFilter textureFilter = TextureFilter::Sampler;
+};
+
+class Shader {
+ public:
+  // `visibility` may be null (everything lit); `secondary` may be null
+  // (mirrors and glass then see black: the pure rasterizer has no rays).
+  Shader(const Scene& scene, const SceneAnalysis& analysis, const Camera& camera, const ShadingOptions& options,
+         const LightVisibility* visibility, const SecondaryRayTracer* secondary);
+
+  // Straight linear RGBA base colour (factor × texture) at a point.
+  glm::vec4 baseColor(const SurfacePoint& point, const TextureFootprint& footprint) const;
+  // The alpha a renderer uses for MASK and BLEND coverage decisions.
+  float coverageAlpha(const SurfacePoint& point, const TextureFootprint& footprint) const;
+
+  // Premultiplied RGBA of the surface seen along `direction` (unit, from
+  // the viewer towards the point), at ray depth `depth`.
+  glm::vec4 shade(const SurfacePoint& point, const glm::dvec3& direction, const TextureFootprint& footprint,
+                  int depth = 0, float throughput = 1.0f) const;
+
+  // Light transmitted through a surface by a shadow ray (SPEC §5): 0 for
+  // opaque and MASK-covered points, 1 − α for BLEND, transmission × C for
+  // refractive ones.
+  glm::vec3 shadowTransmittance(const SurfacePoint& point) const;
+
+  const TextureSet& textures() const { return textures_; }
+  const ShadingOptions& options() const { return options_; }
+
+ private:
+  glm::vec3 directLight(const SurfacePoint& p, const glm::dvec3& n, const glm::dvec3& direction,
+                        const glm::vec3& albedo) const;
+
+  const Scene& scene_;
+  const Camera& camera_;
+  ShadingOptions options_;
+  const LightVisibility* visibility_;
+  const SecondaryRayTracer* secondary_;
+  TextureSet textures_;
+  bool eyeLight_;
+};
+
+}  // namespace rastray

@@ -1,0 +1,56 @@
+// From a preliminary hit (common/hit.h) to the full surface description
+// shading needs: the one place both renderers turn (instance, triangle,
+// b1, b2) into geometry.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "common/camera.h"
+#include "common/hit.h"
+#include "common/scene.h"
+
+namespace rastray {
+
+struct SurfacePoint {
+  uint32_t instance = kNoId;
+  uint32_t triangle = kNoId;
+  const Material* material = nullptr;
+  float b1 = 0.0f, b2 = 0.0f;
+  // Rebuilt from the barycentrics over the stored float vertices, in
+  // double: the error is that of the barycentrics, not of a ray's t
+  // (Ray Tracing Gems ch. 6 rebuilds hit points the same way).
+  glm::dvec3 position{0.0};
+  glm::dvec3 geometricNormal{0.0, 0.0, 1.0};  // unit; the CCW (front) side
+  glm::dvec3 shadingNormal{0.0, 0.0, 1.0};    // unit; authored and interpolated, else geometric
+  glm::vec2 uv{0.0f};
+};
+
+SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit);
+
+// Where a ray meets the plane of stored triangle (instance, triangle), in
+// double precision: t along the ray and barycentrics (b1, b2), with no
+// inside test. Both renderers refine their primary hits with it before
+// shading, so a sample that both attribute to the same triangle is shaded
+// from bit-identical inputs (hybrid == ray cast where hits agree). False
+// when the ray is parallel to the plane or the triangle is degenerate.
+bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle, const Ray& ray,
+                            double* t, glm::dvec2* barycentrics);
+
+// A hit refined by intersectTrianglePlane (depth = t · depthPerT); the hit
+// unchanged when the plane cannot be intersected.
+SampleHit refineHit(const Scene& scene, const Ray& ray, const SampleHit& hit);
+
+// Texture-space footprint of one pixel at a surface point: d(uv)/dx and
+// d(uv)/dy per image pixel. Both renderers compute it the same way, from
+// the camera rays through the neighbouring pixel positions intersected
+// with the triangle's plane, so texture filtering matches exactly; zero
+// means "sample the finest level" (used for secondary hits).
+struct TextureFootprint {
+  glm::vec2 dUVdx{0.0f};
+  glm::vec2 dUVdy{0.0f};
+};
+
+TextureFootprint pixelFootprint(const Scene& scene, const Camera& camera, const SurfacePoint& point,
+                                glm::dvec2 imagePosition);
+
+}  // namespace rastray

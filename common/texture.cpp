@@ -1,0 +1,152 @@
+#include "common/texture.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+#include "common/image.h"
+
+namespace rastray {
+
+const char* toString(TextureFilter filter) {
+  switch (filter) {
+    case TextureFilter::Sampler: return "sampler";
+    case TextureFilter::Nearest: return "nearest";
+    case TextureFilter::Bilinear: return "bilinear";
+    case TextureFilter::Trilinear: return "trilinear";
+  }
+  return "?";
+}
+
+namespace {
+
+MipLevel decodeLevel0(const TextureImage& image) {
+  MipLevel level;
+  level.width = image.width;
+  level.height = image.height;
+  level.texels.resize(size_t(image.width) * size_t(image.height));
+  float lut[256];
+  for (int i = 0; i < 256; ++i) lut[i] = srgbToLinear(i / 255.0f);
+  for (size_t i = 0; i < level.texels.size(); ++i) {
+    const uint8_t* p = &image.rgba8[i * 4];
+    const float a = p[3] / 255.0f;  // alpha is linear in glTF
+    level.texels[i] = glm::vec4(lut[p[0]] * a, lut[p[1]] * a, lut[p[2]] * a, a);
+  }
+  return level;
+}
+
+MipLevel halve(const MipLevel& src) {
+  MipLevel dst;
+  dst.width = std::max(1, src.width / 2);
+  dst.height = std::max(1, src.height / 2);
+  OIIO::ImageSpec srcSpec(src.width, src.height, 4, OIIO::TypeDesc::FLOAT);
+  OIIO::ImageBuf in(srcSpec, const_cast<glm::vec4*>(src.texels.data()));
+  OIIO::ImageSpec dstSpec(dst.width, dst.height, 4, OIIO::TypeDesc::FLOAT);
+  OIIO::ImageBuf out(dstSpec);
+  OIIO::ImageBufAlgo::resize(out, in, "box");
+  dst.texels.resize(size_t(dst.width) * size_t(dst.height));
+  out.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, dst.texels.data());
+  return dst;
+}
+
+int wrap(int i, int n, int mode) {
+  switch (mode) {
+    case 33071: return std::clamp(i, 0, n - 1);  // CLAMP_TO_EDGE
+    case 33648: {                                // MIRRORED_REPEAT
+      const int period = 2 * n;
+      int m = i % period;
+      if (m < 0) m += period;
+      return m < n ? m : period - 1 - m;
+    }
+    default: {  // REPEAT
+      int m = i % n;
+      return m < 0 ? m + n : m;
+    }
+  }
+}
+
+glm::vec4 texel(const MipLevel& level, int x, int y, const TextureSampler& s) {
+  x = wrap(x, level.width, s.wrapS);
+  y = wrap(y, level.height, s.wrapT);
+  return level.texels[size_t(y) * size_t(level.width) + size_t(x)];
+}
+
+// Texel centres sit at half-integers: uv (0, 0) is the top-left corner of
+// texel (0, 0).
+glm::vec4 nearest(const MipLevel& level, glm::vec2 uv, const TextureSampler& s) {
+  return texel(level, int(std::floor(uv.x * level.width)), int(std::floor(uv.y * level.height)), s);
+}
+
+glm::vec4 bilinear(const MipLevel& level, glm::vec2 uv, const TextureSampler& s) {
+  const float x = uv.x * level.width - 0.5f, y = uv.y * level.height - 0.5f;
+  const float fx = std::floor(x), fy = std::floor(y);
+  const int x0 = int(fx), y0 = int(fy);
+  const float tx = x - fx, ty = y - fy;
+  const glm::vec4 a = glm::mix(texel(level, x0, y0, s), texel(level, x0 + 1, y0, s), tx);
+  const glm::vec4 b = glm::mix(texel(level, x0, y0 + 1, s), texel(level, x0 + 1, y0 + 1, s), tx);
+  return glm::mix(a, b, ty);
+}
+
+glm::vec4 unpremultiply(const glm::vec4& c) {
+  return c.a > 0.0f ? glm::vec4(glm::vec3(c) / c.a, c.a) : glm::vec4(0.0f);
+}
+
+}  // namespace
+
+TextureSet::TextureSet(const Scene& scene) {
+  chains_.resize(scene.textures.size());
+  samplers_.resize(scene.textures.size());
+  for (const Material& m : scene.materials) {
+    if (m.baseColorTexture < 0) continue;
+    const size_t t = size_t(m.baseColorTexture);
+    samplers_[t] = scene.textures[t].sampler;
+    if (!chains_[t].empty()) continue;
+    std::vector<MipLevel>& chain = chains_[t];
+    chain.push_back(decodeLevel0(scene.images[size_t(scene.textures[t].image)]));
+    while (chain.back().width > 1 || chain.back().height > 1) chain.push_back(halve(chain.back()));
+  }
+}
+
+size_t TextureSet::levelCount(int texture) const { return chains_[size_t(texture)].size(); }
+
+float TextureSet::levelOfDetail(int texture, const TextureFootprint& fp) const {
+  const MipLevel& l0 = chains_[size_t(texture)][0];
+  const glm::vec2 size(float(l0.width), float(l0.height));
+  const float rho = std::max(glm::length(fp.dUVdx * size), glm::length(fp.dUVdy * size));
+  return rho > 0.0f ? std::log2(rho) : -INFINITY;
+}
+
+glm::vec4 TextureSet::sample(int texture, glm::vec2 uv, const TextureFootprint& fp, TextureFilter filter) const {
+  if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
+  // Keep texel arithmetic in int range: REPEAT is periodic, and clamped
+  // modes give the edge texel for any uv beyond the image anyway.
+  uv = glm::clamp(uv, glm::vec2(-1e6f), glm::vec2(1e6f));
+  const std::vector<MipLevel>& chain = chains_[size_t(texture)];
+  const TextureSampler& s = samplers_[size_t(texture)];
+  if (filter == TextureFilter::Nearest) return unpremultiply(nearest(chain[0], uv, s));
+  if (filter == TextureFilter::Bilinear) return unpremultiply(bilinear(chain[0], uv, s));
+
+  const float lambda = levelOfDetail(texture, fp);
+  const int maxLevel = int(chain.size()) - 1;
+  if (filter == TextureFilter::Sampler && !(lambda > 0.0f)) {
+    // Magnification: the sampler's magFilter (unset: linear).
+    return unpremultiply(s.magFilter == 9728 ? nearest(chain[0], uv, s) : bilinear(chain[0], uv, s));
+  }
+  int minFilter = filter == TextureFilter::Trilinear ? 9987 : s.minFilter;
+  if (minFilter < 0) minFilter = 9987;  // unset: trilinear
+  const bool linearInLevel = minFilter == 9729 || minFilter == 9985 || minFilter == 9987;
+  auto lookup = [&](int level) {
+    const MipLevel& l = chain[size_t(std::clamp(level, 0, maxLevel))];
+    return linearInLevel ? bilinear(l, uv, s) : nearest(l, uv, s);
+  };
+  if (minFilter == 9728 || minFilter == 9729) return unpremultiply(lookup(0));  // no mip-mapping
+  const float lod = std::clamp(lambda, 0.0f, float(maxLevel));
+  if (minFilter == 9984 || minFilter == 9985) return unpremultiply(lookup(int(std::lround(lod))));
+  const int lo = int(std::floor(lod));
+  const float t = lod - float(lo);
+  return unpremultiply(t > 0.0f ? glm::mix(lookup(lo), lookup(lo + 1), t) : lookup(lo));
+}
+
+}  // namespace rastray

@@ -1,0 +1,58 @@
+// Base colour textures: sRGB decoding, mip chains and filtered lookups,
+// shared by both renderers.
+//
+// Mip chains are built in linear, premultiplied float RGBA (so filtering
+// neither darkens nor fringes at alpha edges: the premultiplied-alpha
+// argument of the lecture notes), each level a box-filtered half of the one
+// above it (OpenImageIO's resize), down to 1×1. Lookups return straight
+// (un-premultiplied) linear RGBA.
+//
+// Level of detail follows OpenGL: rho = max(|duv/dx|, |duv/dy|) in texels
+// of level 0, lambda = log2(rho); lambda <= 0 magnifies.
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "common/scene.h"
+#include "common/surface.h"
+
+namespace rastray {
+
+enum class TextureFilter {
+  Sampler,    // as the glTF sampler says (unset: trilinear)
+  Nearest,    // level 0, nearest texel
+  Bilinear,   // level 0, bilinear
+  Trilinear,  // bilinear in the two nearest levels, blended by lambda
+};
+
+const char* toString(TextureFilter filter);
+
+struct MipLevel {
+  int width = 0, height = 0;
+  std::vector<glm::vec4> texels;  // linear, premultiplied; row 0 = top = v 0
+};
+
+class TextureSet {
+ public:
+  TextureSet() = default;
+  // Decodes and builds the chains of every texture a material uses. Leave
+  // it empty (default constructor) for scenes that need no textures.
+  explicit TextureSet(const Scene& scene);
+
+  bool empty() const { return chains_.empty(); }
+  size_t levelCount(int texture) const;
+  const std::vector<MipLevel>& levels(int texture) const { return chains_[size_t(texture)]; }
+
+  // Straight linear RGBA at uv for a footprint.
+  glm::vec4 sample(int texture, glm::vec2 uv, const TextureFootprint& footprint, TextureFilter filter) const;
+  // The level of detail lambda for a footprint (for tests and `explain`).
+  float levelOfDetail(int texture, const TextureFootprint& footprint) const;
+
+ private:
+  std::vector<std::vector<MipLevel>> chains_;  // by texture index; empty for unused ones
+  std::vector<TextureSampler> samplers_;
+};
+
+}  // namespace rastray
