@@ -11,5 +11,6 @@ namespace rastray {
 using CommandRunner = std::function<int()>;
 
 CommandRunner addInfoCommand(CLI::App& app);
+CommandRunner addRenderCommand(CLI::App& app);
 
 }  // namespace rastray

@@ -20,6 +20,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "rastray 0.1");
   std::vector<CommandRunner> commands;
   commands.push_back(addInfoCommand(app));
+#ifdef RASTRAY_HAVE_RENDERERS
+  commands.push_back(addRenderCommand(app));
+#endif
 
   try {
     app.parse(argc, argv);
