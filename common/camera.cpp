@@ -20,7 +20,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 std::string fmt(const glm::dvec3& v) {
   char buf[128];
-  std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", v.x, v.y, v.z);
+  // + 0.0 turns -0 into 0 for printing.
+  std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", v.x + 0.0, v.y + 0.0, v.z + 0.0);
   return buf;
 }
 
