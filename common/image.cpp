@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,8 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <new>
+#include <stdexcept>
 
 #include <OpenImageIO/deepdata.h>
 #include <OpenImageIO/imageio.h>
@@ -37,7 +40,8 @@ const char* const kSample = "id.sample";
 
 std::string lowercaseExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -58,25 +62,28 @@ std::string temporaryPathFor(const std::string& path) {
 void writeAtomically(const std::string& path, const char* format, const OIIO::ImageSpec& spec,
                      const std::function<bool(OIIO::ImageOutput&)>& writePixels) {
   const std::string tmp = temporaryPathFor(path);
+  bool ok = false;
   std::string error;
   try {
     std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(format);
     if (!out) {
       error = OIIO::geterror();
-    } else if (!out->open(tmp, spec) || !writePixels(*out) || !out->close()) {
-      error = out->geterror();
+    } else {
+      ok = out->open(tmp, spec) && writePixels(*out) && out->close();
+      if (!ok) error = out->geterror();
     }
   } catch (...) {
     std::remove(tmp.c_str());
     throw;
   }
   // The ImageOutput is gone (and its file closed) before we rename or remove.
-  if (error.empty() && std::rename(tmp.c_str(), path.c_str()) != 0) {
+  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+    ok = false;
     error = std::string("cannot rename the temporary file into place: ") + std::strerror(errno);
   }
-  if (!error.empty()) {
+  if (!ok) {
     std::remove(tmp.c_str());
-    throw InputError(path, "", "cannot write: " + error);
+    throw InputError(path, "", "cannot write: " + (error.empty() ? "OpenImageIO failed" : error));
   }
 }
 
@@ -95,8 +102,6 @@ void checkFlat(const FlatImage& image) {
                     " with " + std::to_string(image.color.size()) + " colours");
 }
 
-// ---- Reading -------------------------------------------------------------
-
 std::unique_ptr<OIIO::ImageInput> openExr(const std::string& path) {
   std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path);
   if (!in) throw InputError(path, "", "cannot read: " + OIIO::geterror());
@@ -110,12 +115,8 @@ std::unique_ptr<OIIO::ImageInput> openExr(const std::string& path) {
   return in;
 }
 
-int findChannel(const OIIO::ImageSpec& spec, const char* name) {
-  return spec.channelindex(name);
-}
-
 int requireChannel(const std::string& path, const OIIO::ImageSpec& spec, const char* name) {
-  const int c = findChannel(spec, name);
+  const int c = spec.channelindex(name);
   if (c < 0) {
     std::string have;
     for (const std::string& n : spec.channelnames) have += (have.empty() ? "" : " ") + n;
@@ -129,8 +130,8 @@ int requireChannel(const std::string& path, const OIIO::ImageSpec& spec, const c
 // image we return covers the display window; pixels outside the data
 // window read as "nothing here".
 struct Windows {
-  int width, height;        // display window
-  int dataX, dataY;         // data window origin relative to the display window
+  int width, height;  // display window
+  int dataX, dataY;   // data window origin relative to the display window
   int dataWidth, dataHeight;
 };
 
@@ -172,8 +173,9 @@ bool idFromReal(double v, uint32_t& id) {
 [[noreturn]] void badId(const std::string& path, const char* channel, double v, int x, int y) {
   char value[64];
   std::snprintf(value, sizeof value, "%.17g", v);
-  throw InputError(path, std::string("channel ") + channel,
-                   std::string("value ") + value + " at " + pixelName(x, y) + " is not an integer id");
+  throw InputError(
+      path, std::string("channel ") + channel,
+      std::string("value ") + value + " at " + pixelName(x, y) + " is not an integer id");
 }
 
 // Reads one channel of the native pixel buffer into `dst` (one value every
@@ -191,9 +193,8 @@ void convertChannel(const OIIO::ImageSpec& spec, const std::vector<char>& native
 // IDs: UINT channels are copied bit for bit (OIIO would otherwise scale
 // integers as normalized values); half/float go through idFromReal.
 void readIdChannel(const std::string& path, const OIIO::ImageSpec& spec,
-                   const std::vector<char>& native, const char* name,
-                   std::vector<uint32_t>& ids) {
-  const int c = findChannel(spec, name);
+                   const std::vector<char>& native, const char* name, std::vector<uint32_t>& ids) {
+  const int c = spec.channelindex(name);
   if (c < 0) return;  // stays kNoId
   const OIIO::TypeDesc type = spec.channelformat(c);
   if (type.basetype == OIIO::TypeDesc::UINT32) {
@@ -207,10 +208,11 @@ void readIdChannel(const std::string& path, const OIIO::ImageSpec& spec,
   }
   std::vector<double> real(ids.size());
   convertChannel(spec, native, c, OIIO::TypeDesc::DOUBLE, real.data(), sizeof(double));
+  const Windows w = windowsOf(spec);
   for (size_t i = 0; i < ids.size(); ++i) {
     if (!idFromReal(real[i], ids[i])) {
-      badId(path, name, real[i], int(i % size_t(spec.width)) + spec.x,
-            int(i / size_t(spec.width)) + spec.y);
+      badId(path, name, real[i], int(i % size_t(spec.width)) + w.dataX,
+            int(i / size_t(spec.width)) + w.dataY);
     }
   }
 }
@@ -255,8 +257,8 @@ FlatImage::FlatImage(int w, int h) : width(w), height(h) {
   triangle.assign(n, kNoId);
 }
 
-// IEC 61966-2-1, evaluated in double so that the float result is correctly
-// rounded (the 8-bit PNG quantization then never lands on the wrong side).
+// IEC 61966-2-1 exactly (no gamma-2.2 approximation), evaluated in double:
+// the float result is the exact value rounded once to float.
 float srgbToLinear(float encoded) {
   const double v = encoded;
   return float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
@@ -309,7 +311,7 @@ void writeExr(const std::string& path, const FlatImage& image, ColorPrecision pr
       precision == ColorPrecision::Float ? OIIO::TypeFloat : OIIO::TypeHalf;
   OIIO::ImageSpec spec(image.width, image.height, 7, OIIO::TypeFloat);
   spec.channelnames = {kR, kG, kB, kA, kZ, kInstance, kTriangle};
-  spec.channelformats = {colorType,       colorType,       colorType,      colorType,
+  spec.channelformats = {colorType,       colorType,        colorType,       colorType,
                          OIIO::TypeFloat, OIIO::TypeUInt32, OIIO::TypeUInt32};
   spec.alpha_channel = 3;
   spec.z_channel = 4;
@@ -351,9 +353,8 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
   // Colour is float, not half: deep files are for sample-exact analysis.
   OIIO::ImageSpec spec(image.width, image.height, 8, OIIO::TypeFloat);
   spec.channelnames = {kR, kG, kB, kA, kZ, kInstance, kTriangle, kSample};
-  spec.channelformats = {OIIO::TypeFloat,  OIIO::TypeFloat,  OIIO::TypeFloat,
-                         OIIO::TypeFloat,  OIIO::TypeFloat,  OIIO::TypeUInt32,
-                         OIIO::TypeUInt32, OIIO::TypeUInt32};
+  spec.channelformats = {OIIO::TypeFloat, OIIO::TypeFloat,  OIIO::TypeFloat,  OIIO::TypeFloat,
+                         OIIO::TypeFloat, OIIO::TypeUInt32, OIIO::TypeUInt32, OIIO::TypeUInt32};
   spec.alpha_channel = 3;
   spec.z_channel = 4;
   spec.deep = true;
@@ -385,7 +386,9 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
 
 bool isDeepExr(const std::string& path) { return openExr(path)->spec().deep; }
 
-FlatImage readExr(const std::string& path) {
+namespace {
+
+FlatImage readExrUnchecked(const std::string& path) {
   std::unique_ptr<OIIO::ImageInput> in = openExr(path);
   const OIIO::ImageSpec spec = in->spec();
   // Flattening a deep file needs the sample pattern (average the per-sample
@@ -395,8 +398,8 @@ FlatImage readExr(const std::string& path) {
   const int cR = requireChannel(path, spec, kR);
   const int cG = requireChannel(path, spec, kG);
   const int cB = requireChannel(path, spec, kB);
-  const int cA = findChannel(spec, kA);
-  const int cZ = findChannel(spec, kZ);
+  const int cA = spec.channelindex(kA);
+  const int cZ = spec.channelindex(kZ);
 
   // One decode in the file's own formats; every channel is then converted
   // from that buffer.
@@ -437,18 +440,18 @@ FlatImage readExr(const std::string& path) {
   return image;
 }
 
-DeepImage readDeepExr(const std::string& path) {
+DeepImage readDeepExrUnchecked(const std::string& path) {
   std::unique_ptr<OIIO::ImageInput> in = openExr(path);
   const OIIO::ImageSpec spec = in->spec();
   if (!spec.deep) throw InputError(path, "", "flat EXR where a deep one is expected");
   const int cR = requireChannel(path, spec, kR);
   const int cG = requireChannel(path, spec, kG);
   const int cB = requireChannel(path, spec, kB);
-  const int cA = findChannel(spec, kA);
-  const int cZ = findChannel(spec, kZ);
-  const int cInstance = findChannel(spec, kInstance);
-  const int cTriangle = findChannel(spec, kTriangle);
-  const int cSample = findChannel(spec, kSample);
+  const int cA = spec.channelindex(kA);
+  const int cZ = spec.channelindex(kZ);
+  const int cInstance = spec.channelindex(kInstance);
+  const int cTriangle = spec.channelindex(kTriangle);
+  const int cSample = spec.channelindex(kSample);
 
   OIIO::DeepData deep;
   if (!in->read_native_deep_image(0, 0, deep)) {
@@ -500,6 +503,27 @@ DeepImage readDeepExr(const std::string& path) {
     }
   }
   return image;
+}
+
+// A damaged header can claim any size; what cannot be allocated is bad
+// input, not a crash.
+template <typename Read>
+auto readWithinMemory(const std::string& path, Read read) -> decltype(read(path)) {
+  try {
+    return read(path);
+  } catch (const std::bad_alloc&) {
+    throw InputError(path, "", "image too large to load");
+  } catch (const std::length_error&) {
+    throw InputError(path, "", "image too large to load");
+  }
+}
+
+}  // namespace
+
+FlatImage readExr(const std::string& path) { return readWithinMemory(path, readExrUnchecked); }
+
+DeepImage readDeepExr(const std::string& path) {
+  return readWithinMemory(path, readDeepExrUnchecked);
 }
 
 }  // namespace rastray

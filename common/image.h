@@ -1,14 +1,19 @@
 // Images and per-sample AOVs, and their files (SPEC §4, §6).
 //
 // Inside rastray colour is linear RGB with premultiplied alpha. Files:
-// - PNG: sRGB-encoded, un-premultiplied, 8 bit, RGBA.
+// - PNG: sRGB-encoded, un-premultiplied, 8 bit, RGBA. Colour is divided by
+//   alpha (black where alpha is 0), clamped to [0, 1], encoded with the
+//   exact sRGB curve and rounded to the nearest byte.
 // - EXR (flat): channels R G B A (half by default, float on request), Z
 //   (float, view depth, +inf where nothing was hit), id.instance and
-//   id.triangle (uint, 0xFFFFFFFF where nothing was hit).
+//   id.triangle (uint, 0xFFFFFFFF where nothing was hit). Zip compression:
+//   lossless, so Z and IDs come back bit for bit.
 // - Deep EXR: every sample of every pixel and, with transparency, every
 //   layer, front to back; the same channels plus id.sample (uint, the
 //   sample's index in the SPEC §3 pattern) so a reader can tell samples
-//   and layers apart. Deep data are stored as OpenEXR deep scanlines.
+//   and layers apart. Colour is float here (deep files are for
+//   sample-exact analysis). Deep data are stored as OpenEXR deep
+//   scanlines, zips compression.
 // Every file is written to a temporary name beside its target and renamed
 // into place, so an interrupted run never leaves a half-written output.
 #pragma once
@@ -52,9 +57,12 @@ struct DeepImage {
 
 enum class ColorPrecision { Half, Float };
 
-// Writes by extension: .png, or .exr (flat). Throws InputError (file: the
-// output path) when the extension is unknown or the file cannot be written;
-// nothing is left at the target then.
+// Writes by extension: .png, or .exr (flat), in any letter case. Throws
+// InputError (file: the output path) when the extension is unknown (before
+// anything is written) or the file cannot be written; nothing is left at
+// the target then, neither a partial file nor the temporary one
+// ("<stem>.tmp.<pid>.<n><ext>" beside the target). writePng, writeExr and
+// writeDeepExr write their format whatever the extension.
 void writeImage(const std::string& path, const FlatImage& image,
                 ColorPrecision precision = ColorPrecision::Half);
 void writePng(const std::string& path, const FlatImage& image);
@@ -65,9 +73,22 @@ void writeDeepExr(const std::string& path, const DeepImage& image);
 // Readers for the compare tool; accept files from other renderers as long
 // as they carry the SPEC §6 channels (missing Z or IDs read as +inf and
 // kNoId; missing A reads as 1). Throw InputError naming the file and the
-// channel or element at fault.
+// channel or element at fault (element "" when the file as a whole cannot
+// be read: missing, not OpenEXR, truncated or corrupt).
+// - Only the first part (subimage) of a multi-part file is read.
+// - The image covers the display window; pixels outside a smaller data
+//   window read as transparent black, +inf depth, kNoId (no samples, deep).
+// - IDs stored as uint are read bit for bit; IDs stored as half or float
+//   are accepted when integral (float 2^32, the float rounding of
+//   0xFFFFFFFF, reads as kNoId); anything else is an error.
+// - readExr refuses a deep file (flattening needs the sample pattern, which
+//   the caller knows: use isDeepExr and readDeepExr), readDeepExr a flat one.
+// - readDeepExr returns each pixel's samples in the DeepImage order, sorting
+//   if the file had another (NaN depths last); a missing id.sample reads as
+//   0, i.e. all layers of a pixel belong to one sample.
 FlatImage readExr(const std::string& path);
 DeepImage readDeepExr(const std::string& path);
+// Throws InputError like the readers when the file cannot be opened as EXR.
 bool isDeepExr(const std::string& path);
 
 // sRGB transfer functions (IEC 61966-2-1), per channel.
