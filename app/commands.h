@@ -12,5 +12,7 @@ using CommandRunner = std::function<int()>;
 
 CommandRunner addInfoCommand(CLI::App& app);
 CommandRunner addRenderCommand(CLI::App& app);
+CommandRunner addCrossvalCommand(CLI::App& app);
+CommandRunner addCompareCommand(CLI::App& app);
 
 }  // namespace rastray

@@ -5,12 +5,34 @@
 // file and the offending element.
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
 #include "common/error.h"
+
+namespace {
+
+// SPEC §7 promises one line: a message may quote the file's own strings
+// (or a file name) with line breaks or other control characters in them.
+void printErrorLine(const std::string& message) {
+  std::string line;
+  for (const char ch : message) {
+    const unsigned char u = static_cast<unsigned char>(ch);
+    if (u < 0x20 || u == 0x7F) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", u);
+      line += escaped;
+    } else {
+      line += ch;
+    }
+  }
+  std::fprintf(stderr, "%s\n", line.c_str());
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace rastray;
@@ -22,7 +44,9 @@ int main(int argc, char** argv) {
   commands.push_back(addInfoCommand(app));
 #ifdef RASTRAY_HAVE_RENDERERS
   commands.push_back(addRenderCommand(app));
+  commands.push_back(addCrossvalCommand(app));
 #endif
+  commands.push_back(addCompareCommand(app));
 
   try {
     app.parse(argc, argv);
@@ -36,7 +60,7 @@ int main(int argc, char** argv) {
     std::printf("rastray 0.1\n");
     return 0;
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "rastray: %s (see rastray --help)\n", e.what());
+    printErrorLine(std::string("rastray: ") + e.what() + " (see rastray --help)");
     return 2;
   }
 
@@ -47,13 +71,13 @@ int main(int argc, char** argv) {
     }
     return 2;
   } catch (const InputError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
+    printErrorLine(e.what());
     return 2;
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "rastray: out of memory\n");
+    printErrorLine("rastray: out of memory");
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rastray: %s\n", e.what());
+    printErrorLine(std::string("rastray: ") + e.what());
     return 2;
   }
 }

@@ -36,10 +36,11 @@ const char* toString(RendererKind kind) {
   return "?";
 }
 
-void addRenderSettings(CLI::App& cmd, RenderSettings& s) {
-  cmd.add_option("--renderer", s.rendererName, "raster, raytrace or hybrid (rasterized primary visibility, traced "
-                                               "shadow/reflection/refraction rays)")
-      ->capture_default_str();
+void addRenderSettings(CLI::App& cmd, RenderSettings& s, bool withRenderer) {
+  if (withRenderer)
+    cmd.add_option("--renderer", s.rendererName,
+                   "raster, raytrace or hybrid (rasterized primary visibility, traced shadow/reflection/refraction rays)")
+        ->capture_default_str();
   cmd.add_option("--spp", s.spp, "Samples per pixel: " + supportedSampleCounts())->capture_default_str();
   s.camera.addTo(cmd);
   cmd.add_option("--threads", s.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));

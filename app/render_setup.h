@@ -48,7 +48,8 @@ struct RenderSettings {
   void finish();
 };
 
-void addRenderSettings(CLI::App& cmd, RenderSettings& settings);
+// `withRenderer`: whether --renderer is an option (crossval runs all three).
+void addRenderSettings(CLI::App& cmd, RenderSettings& settings, bool withRenderer = true);
 
 struct RenderRun {
   Camera camera;

@@ -87,6 +87,29 @@ void writeAtomically(const std::string& path, const char* format, const OIIO::Im
   }
 }
 
+}  // namespace
+
+void writeTextFile(const std::string& path, const std::string& text) {
+  const std::string tmp = temporaryPathFor(path);
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  std::string error = ok ? "" : std::strerror(errno);
+  if (f && std::fclose(f) != 0 && ok) {
+    ok = false;
+    error = std::strerror(errno);
+  }
+  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+    ok = false;
+    error = std::string("cannot rename the temporary file into place: ") + std::strerror(errno);
+  }
+  if (!ok) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "", "cannot write: " + error);
+  }
+}
+
+namespace {
+
 // NaN and negatives to 0, above 1 to 1.
 float unitClamp(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
 

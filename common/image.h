@@ -91,6 +91,10 @@ DeepImage readDeepExr(const std::string& path);
 // Throws InputError like the readers when the file cannot be opened as EXR.
 bool isDeepExr(const std::string& path);
 
+// Writes a text file (HTML, CSV, JSON) the same atomic way as images.
+// Throws InputError (file: path) when it cannot.
+void writeTextFile(const std::string& path, const std::string& text);
+
 // sRGB transfer functions (IEC 61966-2-1), per channel.
 float srgbToLinear(float encoded);
 float linearToSrgb(float linear);

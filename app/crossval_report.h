@@ -1,0 +1,27 @@
+// The cross-validation report: a self-contained folder (index.html, one
+// page and its images per scene; no network resources) with the renders
+// side by side, the visibility-mismatch map coloured by class with its
+// legend, |ΔZ| and colour-difference heat maps with colour bars, the work
+// counters, the passes left out and the timings.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "app/crossval.h"
+
+namespace rastray {
+
+struct ReportExplanation {
+  std::string key;   // mismatch class machine name
+  std::string file;  // text file in the scene folder
+};
+
+// Writes DIR/index.html and DIR/<scene name>/...; every file atomically.
+// `explanations` (per scene, may be empty) link mismatch classes to
+// `rastray explain` output already written into the scene folders.
+void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResult>& results,
+                         const RenderSettings& settings,
+                         const std::vector<std::vector<ReportExplanation>>& explanations);
+
+}  // namespace rastray
