@@ -1,0 +1,248 @@
+#include "compare/classify.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rastray {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Window depth derivative |dz/dd| at view depth d (see the header).
+double windowDepthSlope(const DepthPlanes& p, double d) {
+  const double n = p.znear, f = p.zfar;
+  if (p.projection == Projection::Orthographic) return 1.0 / (f - n);
+  if (std::isinf(f)) return n / (d * d);
+  return n * f / ((f - n) * d * d);
+}
+
+// The value the format stores at view depth d, before rounding.
+double storedValue(StoredDepthFormat format, const DepthPlanes& p, double d) {
+  const double n = p.znear, f = p.zfar;
+  const bool reversed = format == StoredDepthFormat::FloatReversed;
+  if (p.projection == Projection::Orthographic) return reversed ? (f - d) / (f - n) : (d - n) / (f - n);
+  if (std::isinf(f)) return reversed ? n / d : 1.0 - n / d;
+  return reversed ? n * (f - d) / (d * (f - n)) : f * (d - n) / (d * (f - n));
+}
+
+}  // namespace
+
+const char* toString(MismatchClass c) {
+  switch (c) {
+    case MismatchClass::SharedEdgeTie:
+      return "shared-edge-tie";
+    case MismatchClass::DepthTie:
+      return "depth-tie";
+    case MismatchClass::NearFarPlane:
+      return "near-far-plane";
+    case MismatchClass::SilhouetteEdge:
+      return "silhouette-edge";
+    case MismatchClass::Genuine:
+      return "genuine";
+  }
+  return "?";
+}
+
+const char* displayName(MismatchClass c) {
+  switch (c) {
+    case MismatchClass::SharedEdgeTie:
+      return "shared-edge tie";
+    case MismatchClass::DepthTie:
+      return "depth tie";
+    case MismatchClass::NearFarPlane:
+      return "near/far plane";
+    case MismatchClass::SilhouetteEdge:
+      return "silhouette edge";
+    case MismatchClass::Genuine:
+      return "genuine";
+  }
+  return "?";
+}
+
+const char* toString(StoredDepthFormat f) {
+  switch (f) {
+    case StoredDepthFormat::FloatReversed:
+      return "float-reversed";
+    case StoredDepthFormat::Float:
+      return "float";
+    case StoredDepthFormat::Unorm24:
+      return "unorm24";
+    case StoredDepthFormat::Unorm16:
+      return "unorm16";
+  }
+  return "?";
+}
+
+std::optional<StoredDepthFormat> parseStoredDepthFormat(const std::string& name) {
+  for (StoredDepthFormat f : {StoredDepthFormat::FloatReversed, StoredDepthFormat::Float,
+                              StoredDepthFormat::Unorm24, StoredDepthFormat::Unorm16})
+    if (name == toString(f)) return f;
+  return std::nullopt;
+}
+
+std::string depthFormatFormula(StoredDepthFormat f) {
+  const char* planes =
+      "view-depth resolution = step / |dz/dd|, |dz/dd| = n f/((f-n) d^2) (n/d^2 for f = inf), "
+      "1/(f-n) ortho";
+  switch (f) {
+    case StoredDepthFormat::FloatReversed:
+      return std::string("float-reversed: stores 1-z; step = ulp32(1-z) = 2^(floor(log2(1-z))-23); ") +
+             planes + "; without planes <= d*2^-23; tie when |dZ| <= resolution(D) + ulp32(D), D = max depth";
+    case StoredDepthFormat::Float:
+      return std::string("float: stores z; step = ulp32(z) = 2^(floor(log2 z)-23); ") + planes +
+             "; tie when |dZ| <= resolution(D) + ulp32(D), D = max depth";
+    case StoredDepthFormat::Unorm24:
+      return std::string("unorm24: stores z; step = 2^-24; ") + planes +
+             "; tie when |dZ| <= resolution(D) + ulp32(D), D = max depth";
+    case StoredDepthFormat::Unorm16:
+      return std::string("unorm16: stores z; step = 2^-16; ") + planes +
+             "; tie when |dZ| <= resolution(D) + ulp32(D), D = max depth";
+  }
+  return "?";
+}
+
+double ulp32(double x) {
+  x = std::fabs(x);
+  if (!std::isfinite(x)) return kInf;
+  if (x < std::ldexp(1.0, -126)) return std::ldexp(1.0, -149);  // denormal range: fixed step
+  int e;
+  std::frexp(x, &e);  // x = m·2^e, m in [0.5, 1): IEEE exponent e − 1
+  return std::ldexp(1.0, (e - 1) - 23);
+}
+
+double depthResolution(StoredDepthFormat format, const DepthPlanes& planes, double d) {
+  if (!(d > 0.0) || std::isinf(d)) return kInf;
+  if (!planes.known) return format == StoredDepthFormat::FloatReversed ? d * std::ldexp(1.0, -23) : kInf;
+  double step = 0.0;
+  switch (format) {
+    case StoredDepthFormat::Unorm24:
+      step = std::ldexp(1.0, -24);
+      break;
+    case StoredDepthFormat::Unorm16:
+      step = std::ldexp(1.0, -16);
+      break;
+    case StoredDepthFormat::Float:
+    case StoredDepthFormat::FloatReversed:
+      // Clamped to [0, 1] as the depth buffer clamps: beyond the planes the
+      // stored value saturates.
+      step = ulp32(std::clamp(storedValue(format, planes, d), 0.0, 1.0));
+      break;
+  }
+  return step / windowDepthSlope(planes, d);
+}
+
+double depthTieTolerance(StoredDepthFormat format, const DepthPlanes& planes, double dA, double dB) {
+  const double d = std::max(dA, dB);
+  return depthResolution(format, planes, d) + ulp32(d);
+}
+
+double planeTolerance(StoredDepthFormat format, const DepthPlanes& planes, double plane) {
+  return depthResolution(format, planes, plane) + ulp32(plane);
+}
+
+MismatchClassifier::MismatchClassifier(const ClassifierSettings& settings) : settings_(settings) {}
+
+bool MismatchClassifier::isDepthTie(const HitRecord& a, const HitRecord& b) const {
+  if (!a.isHit() || !b.isHit()) return false;
+  const double dA = a.depth, dB = b.depth;
+  if (!std::isfinite(dA) || !std::isfinite(dB)) return false;
+  const double tol = depthTieTolerance(settings_.depthFormat, settings_.planes, dA, dB);
+  return std::fabs(dA - dB) <= tol;  // tol = inf only when d <= 0, a hit behind the eye: no tie then
+}
+
+bool MismatchClassifier::touchesNearOrFarPlane(const HitRecord& h) const {
+  const DepthPlanes& p = settings_.planes;
+  if (!p.known || !h.isHit() || std::isnan(h.depth)) return false;
+  const double d = h.depth;
+  const double nearTol = planeTolerance(settings_.depthFormat, p, p.znear);
+  if (d <= p.znear + nearTol) return true;  // at or in front of the near plane
+  if (std::isinf(p.zfar)) return false;
+  const double farTol = planeTolerance(settings_.depthFormat, p, p.zfar);
+  return d >= p.zfar - farTol;  // at or beyond the far plane
+}
+
+double MismatchClassifier::distanceToSegment(glm::dvec2 sample, const glm::dvec3& worldP,
+                                             const glm::dvec3& worldQ) const {
+  const Camera& cam = *settings_.camera;
+  glm::dvec3 p = glm::dvec3(cam.viewFromWorld * glm::dvec4(worldP, 1.0));
+  glm::dvec3 q = glm::dvec3(cam.viewFromWorld * glm::dvec4(worldQ, 1.0));
+  // Clip the edge to znear <= depth <= zfar in view space (depth = −z):
+  // the part outside was never rendered, and perspective projection of a
+  // point behind the eye would flip through infinity.
+  double t0 = 0.0, t1 = 1.0;
+  const double dp = -p.z, dq = -q.z;
+  auto clipAgainst = [&](double fp, double fq) {  // keep f >= 0 along p + t(q − p)
+    if (fp < 0.0 && fq < 0.0) return false;
+    if (fp < 0.0) t0 = std::max(t0, fp / (fp - fq));
+    if (fq < 0.0) t1 = std::min(t1, fp / (fp - fq));
+    return t0 <= t1;
+  };
+  if (!clipAgainst(dp - cam.znear, dq - cam.znear)) return kInf;
+  if (std::isfinite(cam.zfar) && !clipAgainst(cam.zfar - dp, cam.zfar - dq)) return kInf;
+  const glm::dvec3 a = p + t0 * (q - p), b = p + t1 * (q - p);
+  const glm::dvec2 scale = cam.ndcScale();
+  auto project = [&](const glm::dvec3& v) {
+    const double w = cam.projection == Projection::Orthographic ? 1.0 : -v.z;
+    return cam.imageFromNdc({v.x / (scale.x * w), v.y / (scale.y * w)});
+  };
+  const glm::dvec2 ia = project(a), ib = project(b);
+  // Point-to-segment distance in pixels.
+  const glm::dvec2 ab = ib - ia, as = sample - ia;
+  const double len2 = glm::dot(ab, ab);
+  const double t = len2 > 0.0 ? std::clamp(glm::dot(as, ab) / len2, 0.0, 1.0) : 0.0;
+  return glm::length(sample - (ia + t * ab));
+}
+
+double MismatchClassifier::distanceToTriangleEdges(glm::dvec2 sample, const HitRecord& hit) {
+  if (!geometric() || !hit.isHit()) return kInf;
+  const Scene& scene = *settings_.scene;
+  const glm::uvec3& tri = scene.triangle(hit.instance, hit.triangle);
+  double best = kInf;
+  for (int e = 0; e < 3; ++e) {
+    const glm::dvec3 p(scene.positions[tri[e]]), q(scene.positions[tri[(e + 1) % 3]]);
+    best = std::min(best, distanceToSegment(sample, p, q));
+  }
+  return best;
+}
+
+double MismatchClassifier::distanceToSharedEdge(glm::dvec2 sample, const HitRecord& a, const HitRecord& b) {
+  if (!geometric() || !a.isHit() || !b.isHit() || a.instance != b.instance || a.triangle == b.triangle)
+    return kInf;
+  const Scene& scene = *settings_.scene;
+  const glm::uvec3& ta = scene.triangle(a.instance, a.triangle);
+  const glm::uvec3& tb = scene.triangle(b.instance, b.triangle);
+  // Common vertices by world position (bitwise equal floats), so meshes
+  // without an index buffer (every vertex duplicated) share edges too.
+  std::vector<glm::vec3> common;
+  for (int i = 0; i < 3; ++i) {
+    const glm::vec3& pa = scene.positions[ta[i]];
+    bool shared = false;
+    for (int j = 0; j < 3; ++j) shared = shared || pa == scene.positions[tb[j]];
+    if (shared && std::find(common.begin(), common.end(), pa) == common.end()) common.push_back(pa);
+  }
+  if (common.size() != 2) return kInf;  // 3: the same triangle twice; <2: no edge
+  return distanceToSegment(sample, glm::dvec3(common[0]), glm::dvec3(common[1]));
+}
+
+MismatchClass MismatchClassifier::classify(glm::dvec2 sample, const HitRecord& a, const HitRecord& b,
+                                           const ImageSpaceEvidence& evidence) {
+  const double limit = settings_.edgeDistance;
+  if (geometric()) {
+    if (distanceToSharedEdge(sample, a, b) <= limit) return MismatchClass::SharedEdgeTie;
+  } else if (a.isHit() && b.isHit() && a.instance == b.instance && a.triangle != b.triangle &&
+             evidence.edgeNearby) {
+    return MismatchClass::SharedEdgeTie;
+  }
+  if (isDepthTie(a, b)) return MismatchClass::DepthTie;
+  if (touchesNearOrFarPlane(a) || touchesNearOrFarPlane(b)) return MismatchClass::NearFarPlane;
+  if (geometric()) {
+    if (distanceToTriangleEdges(sample, a) <= limit || distanceToTriangleEdges(sample, b) <= limit)
+      return MismatchClass::SilhouetteEdge;
+  } else if (evidence.edgeNearby) {
+    return MismatchClass::SilhouetteEdge;
+  }
+  return MismatchClass::Genuine;
+}
+
+}  // namespace rastray
