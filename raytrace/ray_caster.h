@@ -3,12 +3,56 @@
 // It renders images on its own (render) and, for the hybrid renderer,
 // serves the rasterizer's shading through the SecondaryRayTracer and
 // LightVisibility interfaces of common/shading.h.
+//
+// Contract
+// - Primary rays: camera.primaryRay(pixel + sample position) over
+//   [tNear, tFar] (the near and far planes, as the rasterizer clips), in
+//   16×16-pixel tiles in parallel (TBB). Each hit is refined with
+//   refineHit() before shading, exactly as the rasterizer does, so both
+//   shade a shared (instance, triangle) from identical inputs. Z is the
+//   refined hit's view depth (t · depthPerT in double); IDs are Embree's
+//   (geomID, primID) = SPEC §1 (instance, triangle).
+// - Transparency continuation: filter callbacks collect every BLEND hit
+//   along the ray and reject it, so one traversal continues from the same t
+//   with no epsilon; opaque (and refractive, and covered MASK) hits are
+//   accepted and end it. The collected hits in front of the stopping one
+//   are deduplicated (below), ordered by (refined t, instance, triangle)
+//   and composited front to back with premultiplied `over` until the first
+//   opaque surface or until the remaining transmittance 1 − α_acc is below
+//   RayOptions::transparencyCutoff (1e-4). MASK hits with alpha < cutoff
+//   are rejected and ignored. "rays.transparency" counts BLEND layers a ray
+//   continued behind.
+// - Duplicate hits: the same (instance, triangle) twice, or two triangles
+//   of one instance that share a vertex position hit at t equal within 32
+//   float ULPs of (t + |origin| + |vertices|) are one crossing (a ray
+//   through a shared edge or vertex); the first in (t, instance, triangle)
+//   order is kept. Applies to shadow rays as well, so a shared edge never
+//   attenuates twice.
+// - Shadow rays (rtcOccluded1) run to the light (distance, or +inf for
+//   directional lights); occlusion filters accept opaque hits (blocked)
+//   and collect the rest, whose Shader::shadowTransmittance values multiply
+//   (BLEND 1 − α, refractive transmission × C; SPEC §5).
+// - Secondary rays start at offsetRayOrigin() (raytrace/ray_offset.h, Ray
+//   Tracing Gems ch. 6) on the side they leave, tnear 0, and are shaded at
+//   the depth the Shader gives them; --max-depth and the throughput
+//   cut-off come from ShadingOptions.
+// - Deep samples (keepSamples): for every sample, every surface its primary
+//   ray composited, front to back, each with its OWN unattenuated
+//   premultiplied colour (what Shader::shade returns for it), ending with
+//   the opaque one; compositing them with `over` per sample and box-
+//   filtering the samples reproduces the flat pixel. Samples that hit
+//   nothing have no entries.
+// - Flat output: box filter of the samples' premultiplied colours; Z and
+//   IDs of the front-most surface (transparent or opaque) of the sample
+//   nearest the pixel centre (centreSampleIndex).
+// - Counters: rays.primary, rays.shadow, rays.reflection, rays.refraction,
+//   rays.transparency, always all five, per thread and summed.
 #pragma once
 
+#include <glm/glm.hpp>
 #include <memory>
 #include <optional>
-
-#include <glm/glm.hpp>
+#include <vector>
 
 #include "common/analysis.h"
 #include "common/camera.h"
@@ -23,13 +67,40 @@ struct RayOptions {
   ShadingOptions shading;            // maxDepth, throughput cut-off, texture filter
   float transparencyCutoff = 1e-4f;  // stop compositing once remaining transmittance is below
   bool keepSamples = false;          // fill RenderOutput::samples (deep output, crossval)
-  bool packets = true;               // coherent packets for primary rays where faster
-  std::optional<glm::ivec2> debugPixel;
+  // Primary rays in 8-wide coherent packets (rtcIntersect8) where that is
+  // faster: measured faster without BLEND materials, slower with them
+  // (lanes diverge over the many rejected layer hits), so scenes with BLEND
+  // trace single rays unless forcePackets. false: always single rays (the
+  // scalar reference path).
+  bool packets = true;
+  bool forcePackets = false;
+  int tileSize = 16;                     // pixels per side of a parallel work item
+  std::optional<glm::ivec2> debugPixel;  // print that pixel's ray tree to stderr
+};
+
+// One traced ray of a pixel's ray tree (--debug-pixel and tests).
+struct RayRecord {
+  RayKind kind = RayKind::Primary;
+  int depth = 0;   // primary 0, each bounce +1; shadow rays: the depth of the ray whose hit they light
+  int sample = 0;  // sample index within the pixel
+  glm::dvec3 origin{0.0};
+  glm::dvec3 direction{0.0};
+  double tNear = 0.0, tFar = 0.0;
+  // The front-most surface the ray met (kNoId: none), its t, and how many
+  // surfaces it composited (transparent layers and the opaque one).
+  uint32_t instance = kNoId, triangle = kNoId;
+  double t = 0.0;
+  int layers = 0;
+  // Primary and secondary rays: premultiplied RGBA they return (alpha 1
+  // for secondary rays that hit something). Shadow rays: the per-channel
+  // transmittance in rgb, alpha 1.
+  glm::vec4 contribution{0.0f};
 };
 
 class RayCaster : public SecondaryRayTracer, public LightVisibility {
  public:
   // Builds the Embree device and scene from the shared triangle store.
+  // `scene` must outlive the caster; `analysis` is copied.
   RayCaster(const Scene& scene, const SceneAnalysis& analysis);
   ~RayCaster() override;
   RayCaster(const RayCaster&) = delete;
@@ -50,6 +121,11 @@ class RayCaster : public SecondaryRayTracer, public LightVisibility {
   // Rays traced since bind(), by kind (SPEC §8: zero for what the scene
   // does not need).
   CounterSet counters() const;
+
+  // The ray tree of one pixel (all its samples), traced with single rays
+  // exactly as render() traces them; does not touch the counters.
+  std::vector<RayRecord> traceDebugPixel(glm::ivec2 pixel) const;
+  static void printRayTree(const std::vector<RayRecord>& records, glm::ivec2 pixel);
 
  private:
   struct Impl;

@@ -1,0 +1,121 @@
+#include "raytrace/embree_scene.h"
+
+#include <cstdio>
+#include <stdexcept>
+
+#include "common/error.h"
+
+namespace rastray {
+
+namespace {
+
+const char* errorName(RTCError code) {
+  switch (code) {
+    case RTC_ERROR_NONE:
+      return "none";
+    case RTC_ERROR_UNKNOWN:
+      return "unknown";
+    case RTC_ERROR_INVALID_ARGUMENT:
+      return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION:
+      return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY:
+      return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU:
+      return "unsupported CPU";
+    case RTC_ERROR_CANCELLED:
+      return "cancelled";
+  }
+  return "?";
+}
+
+}  // namespace
+
+bool needsFilter(const Material& material) {
+  return material.alphaMode != AlphaMode::Opaque || material.isRefractive();
+}
+
+void EmbreeScene::onError(void* userPtr, RTCError code, const char* message) {
+  auto* self = static_cast<EmbreeScene*>(userPtr);
+  const std::string text = std::string("embree: ") + errorName(code) + ": " + (message ? message : "");
+  std::fprintf(stderr, "rastray: %s\n", text.c_str());
+  std::lock_guard<std::mutex> lock(self->errorMutex_);
+  if (self->firstError_.empty()) self->firstError_ = text;
+}
+
+void EmbreeScene::throwIfError() {
+  std::lock_guard<std::mutex> lock(errorMutex_);
+  if (firstError_.empty()) return;
+  const std::string text = firstError_;
+  firstError_.clear();
+  throw std::runtime_error(text);
+}
+
+EmbreeScene::EmbreeScene(const Scene& scene, const SceneAnalysis& analysis,
+                         RTCFilterFunctionN intersectFilter, RTCFilterFunctionN occludedFilter,
+                         void* filterUserPtr) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error("embree: cannot create a device");
+  rtcSetDeviceErrorFunction(device_, &EmbreeScene::onError, this);
+
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
+
+  const bool filters = analysis.needsRayFilters();
+  for (uint32_t id = 0; id < uint32_t(scene.instances.size()); ++id) {
+    const Instance& inst = scene.instances[id];
+    if (inst.triangleCount == 0) continue;
+    RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Copies, not shared buffers: Embree wants 16 readable bytes at the
+    // last vertex, which rtcSetNewGeometryBuffer pads for us.
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), inst.vertexCount));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), inst.triangleCount));
+    if (!vertices || !indices) {
+      rtcReleaseGeometry(geometry);
+      throwIfError();
+      throw std::runtime_error("embree: cannot allocate geometry buffers");
+    }
+    for (uint32_t v = 0; v < inst.vertexCount; ++v) {
+      const glm::vec3& p = scene.positions[inst.firstVertex + v];
+      vertices[3 * v + 0] = p.x;
+      vertices[3 * v + 1] = p.y;
+      vertices[3 * v + 2] = p.z;
+    }
+    for (uint32_t t = 0; t < inst.triangleCount; ++t) {
+      const glm::uvec3 tri = scene.triangles[inst.firstTriangle + t];
+      RASTRAY_CHECK(tri.x >= inst.firstVertex && tri.x < inst.firstVertex + inst.vertexCount &&
+                        tri.y >= inst.firstVertex && tri.y < inst.firstVertex + inst.vertexCount &&
+                        tri.z >= inst.firstVertex && tri.z < inst.firstVertex + inst.vertexCount,
+                    "instance " + std::to_string(id) + " triangle " + std::to_string(t) +
+                        " indexes a vertex outside the instance's range");
+      glm::uvec3 local = tri - glm::uvec3(inst.firstVertex);
+      // The loader's degenerate test (zero cross product in double).
+      const glm::dvec3 a(scene.positions[tri.x]), b(scene.positions[tri.y]), c(scene.positions[tri.z]);
+      if (glm::cross(b - a, c - a) == glm::dvec3(0.0)) local = glm::uvec3(local.x);
+      indices[3 * t + 0] = local.x;
+      indices[3 * t + 1] = local.y;
+      indices[3 * t + 2] = local.z;
+    }
+    if (filters && needsFilter(scene.materials[inst.material])) {
+      rtcSetGeometryUserData(geometry, filterUserPtr);
+      rtcSetGeometryIntersectFilterFunction(geometry, intersectFilter);
+      rtcSetGeometryOccludedFilterFunction(geometry, occludedFilter);
+      ++filterGeometries_;
+    }
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometryByID(scene_, geometry, id);
+    rtcReleaseGeometry(geometry);
+  }
+  rtcCommitScene(scene_);
+  throwIfError();
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+}  // namespace rastray

@@ -1,0 +1,154 @@
+// Snell refraction, exact Fresnel and total internal reflection: the
+// optics functions alone, and through the ray caster's ray tree (glass
+// slab lateral shift, TIR just past the critical angle).
+#include "common/optics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "raytrace/ray_caster.h"
+#include "test_scenes.h"
+
+namespace rastray {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Fresnel transmittance computed independently from the reflectance
+// (the amplitude transmission coefficients with the power factor
+// n2 cosθt / n1 cosθi), so R + T = 1 is a real check.
+double fresnelTransmittance(double cosI, double eta) {
+  const double sin2T = eta * eta * (1.0 - cosI * cosI);
+  if (sin2T >= 1.0) return 0.0;
+  const double cosT = std::sqrt(1.0 - sin2T);
+  // n1 = eta, n2 = 1.
+  const double ts = 2.0 * eta * cosI / (eta * cosI + cosT);
+  const double tp = 2.0 * eta * cosI / (cosI + eta * cosT);
+  const double factor = cosT / (eta * cosI);
+  return 0.5 * factor * (ts * ts + tp * tp);
+}
+
+TEST(Fresnel, NormalIncidenceMatchesClosedForm) {
+  for (double n : {1.33, 1.5, 2.4}) {
+    const double expected = ((n - 1.0) / (n + 1.0)) * ((n - 1.0) / (n + 1.0));
+    EXPECT_NEAR(fresnelDielectric(1.0, 1.0 / n), expected, 1e-15) << "entering n " << n;
+    EXPECT_NEAR(fresnelDielectric(1.0, n), expected, 1e-15) << "leaving n " << n;
+  }
+}
+
+TEST(Fresnel, ReflectanceAndTransmittanceSumToOne) {
+  for (double eta : {1.0 / 1.5, 1.5, 1.0 / 2.4})
+    for (int i = 0; i <= 100; ++i) {
+      const double cosI = i / 100.0;
+      const double R = fresnelDielectric(cosI, eta);
+      const double T = fresnelTransmittance(cosI, eta);
+      ASSERT_GE(R, 0.0);
+      ASSERT_LE(R, 1.0);
+      if (cosI > 0.0) {
+        EXPECT_NEAR(R + T, 1.0, 1e-12) << "eta " << eta << " cosI " << cosI;
+      }
+    }
+}
+
+TEST(Refraction, TotalInternalReflectionJustPastTheCriticalAngle) {
+  const double eta = 1.5;  // leaving glass
+  const double critical = std::asin(1.0 / eta);
+  const glm::dvec3 n(0.0, 0.0, 1.0);
+  for (double delta : {1e-6, 1e-3, 0.01}) {
+    const double past = critical + delta, before = critical - delta;
+    const glm::dvec3 dPast(std::sin(past), 0.0, -std::cos(past));
+    const glm::dvec3 dBefore(std::sin(before), 0.0, -std::cos(before));
+    EXPECT_FALSE(refract(dPast, n, eta).has_value()) << "delta " << delta;
+    EXPECT_EQ(fresnelDielectric(std::cos(past), eta), 1.0);
+    const auto t = refract(dBefore, n, eta);
+    ASSERT_TRUE(t.has_value()) << "delta " << delta;
+    EXPECT_LT(fresnelDielectric(std::cos(before), eta), 1.0);
+    // Snell: n1 sinθi = n2 sinθt, with the refracted ray on the far side.
+    EXPECT_NEAR(std::sqrt(t->x * t->x + t->y * t->y), eta * std::sin(before), 1e-9);
+    EXPECT_LT(t->z, 0.0);
+  }
+}
+
+// A closed glass slab z ∈ [−d, 0] (large in x and y) seen by an
+// orthographic camera at incidence θi: the ray that leaves through the
+// back face is parallel to the primary ray and shifted sideways by
+// d·sin(θi − θt)/cos θt.
+TEST(RayTree, GlassSlabExitIsParallelWithTheAnalyticShift) {
+  const double d = 0.5, ior = 1.5;
+  for (double degrees : {0.0, 20.0, 45.0, 70.0}) {
+    const double thetaI = degrees * kPi / 180.0;
+    test::SceneBuilder b;
+    const uint32_t glass = b.addMaterial(test::SceneBuilder::glass(float(ior)));
+    b.addBox({-4.0f, -4.0f, float(-d)}, {4.0f, 4.0f, 0.0f}, glass);
+    const glm::dvec3 dir(std::sin(thetaI), 0.0, -std::cos(thetaI));
+    const glm::dvec3 target(0.1, 0.05, 0.0);
+    b.setCamera(Projection::Orthographic, target - 2.0 * dir, target, {0.0, 1.0, 0.0}, 0.25, 0.0, 10.0);
+    const Scene& scene = b.scene();
+    const SceneAnalysis analysis = analyzeScene(scene);
+    RayCaster caster(scene, analysis);
+    caster.bind(makeCamera(scene, {}, 9, 9), RayOptions{});
+    const std::vector<RayRecord> tree = caster.traceDebugPixel({4, 4});
+    ASSERT_FALSE(tree.empty());
+    const RayRecord& primary = tree.front();
+    ASSERT_EQ(primary.kind, RayKind::Primary);
+    ASSERT_EQ(primary.instance, 0u);
+    const RayRecord* exit = nullptr;
+    for (const RayRecord& r : tree)
+      if (r.kind == RayKind::Refraction && r.depth == 2) {
+        exit = &r;
+        break;
+      }
+    ASSERT_NE(exit, nullptr) << "no refraction ray out of the slab at " << degrees << " deg";
+    // Parallel to the entry.
+    EXPECT_LT(glm::length(glm::cross(exit->direction, primary.direction)), 1e-9) << degrees << " deg";
+    EXPECT_GT(glm::dot(exit->direction, primary.direction), 0.0);
+    // Lateral shift: the distance between the two lines.
+    const double thetaT = std::asin(std::sin(thetaI) / ior);
+    const double expected = d * std::sin(thetaI - thetaT) / std::cos(thetaT);
+    const double shift = glm::length(glm::cross(exit->origin - primary.origin, primary.direction));
+    EXPECT_NEAR(shift, expected, 5e-5) << degrees << " deg";
+    // The exit ray starts on the back face (z = −d), just outside it.
+    EXPECT_NEAR(exit->origin.z, -d, 5e-5);
+    EXPECT_LT(exit->origin.z, -d);
+  }
+}
+
+// A ray inside glass meets the glass/air boundary (the back of a glass
+// quad, so it is leaving): past the critical angle only a reflection ray
+// is traced; just before it, a refraction ray too, obeying Snell's law.
+TEST(RayTree, TotalInternalReflectionAtTheCriticalAngle) {
+  const double ior = 1.5;
+  const double critical = std::asin(1.0 / ior);
+  for (double delta : {-0.5, 0.5}) {
+    const double thetaI = critical + delta * kPi / 180.0;
+    test::SceneBuilder b;
+    const uint32_t glass = b.addMaterial(test::SceneBuilder::glass(float(ior)));
+    // Front faces −z: the camera (looking down −z) sees its back.
+    b.addQuad({0.0, 0.0, 0.0}, {0.0, 3.0, 0.0}, {3.0, 0.0, 0.0}, glass);
+    const glm::dvec3 dir(std::sin(thetaI), 0.0, -std::cos(thetaI));
+    b.setCamera(Projection::Orthographic, -2.0 * dir, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.25, 0.0, 10.0);
+    const Scene& scene = b.scene();
+    RayCaster caster(scene, analyzeScene(scene));
+    caster.bind(makeCamera(scene, {}, 5, 5), RayOptions{});
+    const std::vector<RayRecord> tree = caster.traceDebugPixel({2, 2});
+    ASSERT_FALSE(tree.empty());
+    ASSERT_EQ(tree.front().instance, 0u);
+    int reflections = 0, refractions = 0;
+    for (const RayRecord& r : tree) {
+      if (r.depth != 1) continue;
+      if (r.kind == RayKind::Reflection) ++reflections;
+      if (r.kind == RayKind::Refraction) {
+        ++refractions;
+        const double sinT = std::sqrt(r.direction.x * r.direction.x + r.direction.y * r.direction.y);
+        EXPECT_NEAR(sinT, ior * std::sin(thetaI), 1e-9);
+        EXPECT_LT(r.direction.z, 0.0);  // out through the boundary
+      }
+    }
+    EXPECT_EQ(reflections, 1) << "delta " << delta;
+    EXPECT_EQ(refractions, delta > 0.0 ? 0 : 1) << "delta " << delta;
+  }
+}
+
+}  // namespace
+}  // namespace rastray
