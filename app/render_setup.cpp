@@ -66,7 +66,7 @@ void addRenderSettings(CLI::App& cmd, RenderSettings& s, bool withRenderer) {
                                                   "triangle, as MSAA)")
       ->capture_default_str();
   cmd.add_flag("--wireframe", s.raster.wireframe, "Draw visible triangle edges over the image");
-  cmd.add_flag("--halo", s.raster.halo, "With --wireframe: gap edges where they pass behind others");
+  cmd.add_flag("--halo", s.raster.halo, "With --wireframe: gap each edge where a nearer edge crosses it");
   // Ray caster.
   cmd.add_option("--transparency-cutoff", s.ray.transparencyCutoff,
                  "Stop compositing along a ray once the remaining transmittance is below this")

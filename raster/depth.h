@@ -1,0 +1,73 @@
+// Depth formats, depth keys and polygon offset.
+//
+// Every format stores a window depth z in [0, 1] computed from the view
+// depth d (znear n, zfar f; f may be +inf for perspective):
+//   conventional (Float, Unorm24, Unorm16): perspective z = f(d − n) / (d(f − n)),
+//     i.e. 1 − n/d for f = inf; orthographic z = (d − n) / (f − n). Near 0, far 1.
+//   FloatReversed: 1 − the conventional z (near 1, far 0), the default.
+// z/w is affine in screen space, so z is interpolated linearly over the
+// screen from the vertices (in double) and only then rounded to the format.
+//
+// Precision (the smallest step the buffer can tell apart, at view depth d):
+//   Unorm16: 2^-16 in z, ≈ d²/n · 2^-16 in view depth (perspective, f = inf).
+//   Unorm24: 2^-24 in z, ≈ d²/n · 2^-24.
+//   Float:   z near 1 has ULP 2^-24, the same as unorm24 far from the camera,
+//            and far better only near the near plane, where z is small.
+//   FloatReversed: z ≈ n/d is small far away, where float's exponent gives
+//            relative precision 2^-24 in z, i.e. ≈ d · 2^-24 in view depth:
+//            nearly constant relative precision at every distance.
+// Orthographic z is linear in d, so the steps are (f − n) times the above.
+//
+// The raster stages compare *depth keys*: a uint32 per format where a
+// smaller key is nearer (float bit patterns of non-negative floats sort as
+// integers; reversed keys are mirrored). kClearDepthKey lies beyond every
+// format's far plane, so the first fragment at a sample always passes.
+#pragma once
+
+#include <cstdint>
+
+#include "raster/rasterizer.h"
+
+namespace rastray {
+
+constexpr uint32_t kClearDepthKey = 0xFFFFFFFFu;
+
+// Window depth z in [0, 1] of view depth d in `format` (see above).
+double windowDepth(DepthFormat format, Projection projection, double znear, double zfar, double d);
+
+// The key stored for window depth z (clamped to [0, 1] first, as GL clamps).
+uint32_t depthKey(DepthFormat format, double z);
+
+// True when the format stores larger z for nearer surfaces.
+inline bool isReversed(DepthFormat format) { return format == DepthFormat::FloatReversed; }
+
+// glPolygonOffset's r: the smallest difference the format resolves for a
+// primitive whose largest window depth is maxZ: 2^-bits for unorm (as the
+// brief fixes it), 2^(e − 23) for float with e the exponent of maxZ
+// (OpenGL 4.6 §14.6.5).
+double minimumResolvableDifference(DepthFormat format, double maxZ);
+
+// The offset to add to window depth *away from the viewer* (positive
+// factor/units push back, glPolygonOffset): factor·DZ + units·r, with DZ
+// = max(|∂z/∂x|, |∂z/∂y|) in z per pixel. Callers add it for conventional
+// formats and subtract it for reversed ones.
+double polygonOffset(DepthFormat format, double factor, double units, double maxSlope, double maxZ);
+
+// The depth-test rule for a fragment against the stored (key, id), with
+// (instance, triangle) packed into `id` for ties: the result is what
+// OpenGL gives when primitives are submitted in (instance, triangle)
+// order, so it does not depend on the real submission order:
+//   Less:   nearer, or equal and a lower id (the first submitted keeps it);
+//   LEqual: nearer, or equal and an id not lower (the last submitted wins).
+inline bool passesDepthTest(DepthFunc func, uint32_t key, uint64_t id, uint32_t storedKey,
+                            uint64_t storedId) {
+  if (key != storedKey) return key < storedKey;
+  return func == DepthFunc::Less ? id < storedId : id >= storedId;
+}
+
+inline uint64_t packId(uint32_t instance, uint32_t triangle) { return (uint64_t(instance) << 32) | triangle; }
+
+const char* toString(DepthFormat format);
+const char* toString(DepthFunc func);
+
+}  // namespace rastray

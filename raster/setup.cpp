@@ -1,0 +1,251 @@
+#include "raster/setup.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "common/error.h"
+#include "common/sampling.h"
+#include "raster/depth.h"
+
+namespace rastray {
+
+SampleGrid makeSampleGrid(int spp, int width, int height) {
+  SampleGrid g;
+  g.spp = spp;
+  try {
+    g.positions = samplePositions(spp);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("command line", "--spp", e.what());
+  }
+  // The denominators are 16 (Direct3D patterns) or 2n (grids).
+  const int64_t base = int64_t(1) << kSubpixelBits;
+  int64_t denominator = 16;
+  if (spp > 16) denominator = 2 * int64_t(std::lround(std::sqrt(double(spp))));
+  g.k = denominator / std::gcd(denominator, base);
+  g.unitsPerPixel = base * g.k;
+  for (const glm::dvec2& p : g.positions) {
+    const glm::i64vec2 o(std::llround(p.x * double(g.unitsPerPixel)),
+                         std::llround(p.y * double(g.unitsPerPixel)));
+    if (double(o.x) != p.x * double(g.unitsPerPixel) || double(o.y) != p.y * double(g.unitsPerPixel))
+      throw InputError("command line", "--spp", "sample position not on the fixed-point grid");
+    g.offsets.push_back(o);
+  }
+  g.safePixels = double(kMaxCoordinateUnits / g.unitsPerPixel);
+  const double limit = double((int64_t(1) << 20) / g.k);
+  if (width > limit || height > limit)
+    throw InputError("command line", "--size",
+                     "image larger than " + std::to_string(int64_t(limit)) + " pixels at " +
+                         std::to_string(spp) + " spp exceeds the rasterizer's fixed-point range");
+  g.guardPixels = g.safePixels - 2.0 - double(std::max(width, height));
+  return g;
+}
+
+namespace {
+
+Plane makePlane(const double x[3], const double y[3], const double a[3], double area2) {
+  Plane p;
+  p.x0 = x[0];
+  p.y0 = y[0];
+  p.v0 = a[0];
+  p.dx = ((a[1] - a[0]) * (y[2] - y[0]) - (a[2] - a[0]) * (y[1] - y[0])) / area2;
+  p.dy = ((a[2] - a[0]) * (x[1] - x[0]) - (a[1] - a[0]) * (x[2] - x[0])) / area2;
+  return p;
+}
+
+int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+}  // namespace
+
+SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& ds,
+                           const ClipVertex v[3], CullMode cull, TriangleSetup* t) {
+  const double U = double(grid.unitsPerPixel);
+  glm::i64vec2 snapped[3];
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec2 image = space.imageOf(v[i].position);
+    // Clamping only moves vertices that the guard-band clip left a rounding
+    // error beyond it; inside the range it is the identity.
+    const auto snap = [&](double c) {
+      const double s = std::round(c * U);
+      return int64_t(std::clamp(s, -double(kMaxCoordinateUnits), double(kMaxCoordinateUnits)));
+    };
+    snapped[i] = {snap(image.x), snap(image.y)};
+  }
+  const int64_t area2 = (snapped[1].x - snapped[0].x) * (snapped[2].y - snapped[0].y) -
+                        (snapped[1].y - snapped[0].y) * (snapped[2].x - snapped[0].x);
+  if (area2 == 0) return SetupOutcome::Degenerate;  // zero area after snapping: covers nothing
+  t->frontFacing = area2 < 0;                       // CCW with y up = negative with y down
+  if ((cull == CullMode::Back && !t->frontFacing) || (cull == CullMode::Front && t->frontFacing))
+    return SetupOutcome::Culled;
+
+  // Reorder to positive area: swap vertices 1 and 2 of front faces.
+  const int order[3] = {0, area2 > 0 ? 1 : 2, area2 > 0 ? 2 : 1};
+  const ClipVertex* cv[3];
+  for (int i = 0; i < 3; ++i) {
+    t->vertex[i] = snapped[order[i]];
+    cv[i] = &v[order[i]];
+    t->bary[i] = cv[i]->bary;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    EdgeFunction& e = t->edge[i];
+    const int64_t dx = t->vertex[j].x - t->vertex[i].x, dy = t->vertex[j].y - t->vertex[i].y;
+    e.a = -dy;
+    e.b = dx;
+    e.c = -(e.a * t->vertex[i].x + e.b * t->vertex[i].y);
+    e.topLeft = (dy == 0 && dx > 0) || dy < 0;
+    e.bias = e.topLeft ? 0 : -1;
+    e.original = false;
+    for (int k = 0; k < 3; ++k)
+      if (t->bary[i][k] == 0.0 && t->bary[j][k] == 0.0) e.original = true;
+  }
+
+  const int64_t minX = std::min({t->vertex[0].x, t->vertex[1].x, t->vertex[2].x});
+  const int64_t maxX = std::max({t->vertex[0].x, t->vertex[1].x, t->vertex[2].x});
+  const int64_t minY = std::min({t->vertex[0].y, t->vertex[1].y, t->vertex[2].y});
+  const int64_t maxY = std::max({t->vertex[0].y, t->vertex[1].y, t->vertex[2].y});
+  t->pixelMin = {int(std::clamp<int64_t>(floorDiv(minX, grid.unitsPerPixel), 0, space.width)),
+                 int(std::clamp<int64_t>(floorDiv(minY, grid.unitsPerPixel), 0, space.height))};
+  t->pixelMax = {int(std::clamp<int64_t>(floorDiv(maxX, grid.unitsPerPixel), -1, space.width - 1)),
+                 int(std::clamp<int64_t>(floorDiv(maxY, grid.unitsPerPixel), -1, space.height - 1))};
+
+  // Planes over image pixels from the unsnapped positions: depth and
+  // barycentrics then stay those of the true triangle (what a ray caster
+  // sees) to double precision; snapping only decides coverage. Slivers
+  // whose unsnapped area vanishes fall back to the snapped positions.
+  double x[3], y[3], z[3], invW[3], dOverW[3], b1[3], b2[3];
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec2 image = space.imageOf(cv[i]->position);
+    x[i] = image.x;
+    y[i] = image.y;
+  }
+  double areaPixels = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+  if (!(areaPixels > 0.0) || !std::isfinite(areaPixels)) {
+    for (int i = 0; i < 3; ++i) {
+      x[i] = double(t->vertex[i].x) / U;
+      y[i] = double(t->vertex[i].y) / U;
+    }
+    areaPixels = double(std::abs(area2)) / (U * U);
+  }
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec4& p = cv[i]->position;
+    z[i] = windowDepth(ds.format, ds.projection, ds.znear, ds.zfar, p.z);
+    invW[i] = 1.0 / p.w;
+    dOverW[i] = p.z / p.w;
+    b1[i] = cv[i]->bary.y / p.w;
+    b2[i] = cv[i]->bary.z / p.w;
+  }
+  t->depth = makePlane(x, y, z, areaPixels);
+  t->invW = makePlane(x, y, invW, areaPixels);
+  t->dOverW = makePlane(x, y, dOverW, areaPixels);
+  t->b1OverW = makePlane(x, y, b1, areaPixels);
+  t->b2OverW = makePlane(x, y, b2, areaPixels);
+  t->maxDepthSlope = std::max(std::abs(t->depth.dx), std::abs(t->depth.dy));
+  const double offset = polygonOffset(ds.format, ds.offsetFactor, ds.offsetUnits, t->maxDepthSlope,
+                                      std::max({z[0], z[1], z[2]}));
+  // Positive offsets push away from the viewer: towards 1 conventionally, 0 reversed.
+  t->depth.v0 += isReversed(ds.format) ? -offset : offset;
+  return (t->pixelMin.x > t->pixelMax.x || t->pixelMin.y > t->pixelMax.y) ? SetupOutcome::Offscreen
+                                                                          : SetupOutcome::Ok;
+}
+
+}  // namespace rastray
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace rastray {
+
+std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
+                                            const SampleGrid& grid, const DepthSettings& depth, CullMode cull,
+                                            TriangleFilter filter, SetupCounters* counters) {
+  // Work in chunks of one instance's triangles, each with its own output,
+  // concatenated in chunk order: deterministic whatever the scheduling.
+  struct Chunk {
+    uint32_t instance, first, count;
+    std::vector<TriangleSetup> out;
+    SetupCounters counters;
+  };
+  constexpr uint32_t kChunk = 2048;
+  std::vector<Chunk> chunks;
+  for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    const AlphaMode mode = scene.materials[inst.material].alphaMode;
+    if (mode == AlphaMode::Blend ? !filter.blend : !filter.opaque) continue;
+    for (uint32_t f = 0; f < inst.triangleCount; f += kChunk)
+      chunks.push_back({i, f, std::min(kChunk, inst.triangleCount - f), {}, {}});
+  }
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t c = r.begin(); c != r.end(); ++c) {
+          Chunk& chunk = chunks[c];
+          const Instance& inst = scene.instances[chunk.instance];
+          const CullMode instanceCull = scene.materials[inst.material].doubleSided ? CullMode::None : cull;
+          SetupCounters& n = chunk.counters;
+          for (uint32_t k = chunk.first; k < chunk.first + chunk.count; ++k) {
+            ++n.trianglesIn;
+            const glm::uvec3 idx = scene.triangles[inst.firstTriangle + k];
+            const glm::dvec3 p[3] = {glm::dvec3(scene.positions[idx.x]), glm::dvec3(scene.positions[idx.y]),
+                                     glm::dvec3(scene.positions[idx.z])};
+            if (glm::cross(p[1] - p[0], p[2] - p[0]) == glm::dvec3(0.0)) {
+              ++n.degenerate;  // SPEC §1: zero world area covers nothing
+              continue;
+            }
+            glm::dvec4 clip[3];
+            for (int i = 0; i < 3; ++i)
+              clip[i] =
+                  space.project(glm::dvec3(space.viewFromWorld * glm::dvec4(p[i], 1.0)), glm::dvec3(0.0))
+                      .position;
+            const ClipResult cr = clipTriangle(space, clip);
+            if (cr.outcome == ClipOutcome::Outside) {
+              ++n.outside;
+              continue;
+            }
+            if (cr.outcome == ClipOutcome::Clipped) {
+              ++n.clipped;
+              if (cr.guardClipped) ++n.guardBandClipped;
+              n.fromClipping += uint64_t(cr.count - 2);
+            }
+            TriangleSetup t;
+            t.instance = chunk.instance;
+            t.triangle = k;
+            t.parent = inst.firstTriangle + k;
+            t.fromClipping = cr.outcome == ClipOutcome::Clipped;
+            t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
+            bool culled = false, visible = false, degenerate = false;
+            for (int i = 1; i + 1 < cr.count; ++i) {
+              const ClipVertex fan[3] = {cr.vertices[0], cr.vertices[i], cr.vertices[i + 1]};
+              const SetupOutcome o = setupTriangle(space, grid, depth, fan, instanceCull, &t);
+              if (o == SetupOutcome::Culled) culled = true;
+              if (o == SetupOutcome::Degenerate) degenerate = true;
+              if (o != SetupOutcome::Ok) continue;
+              visible = true;
+              chunk.out.push_back(t);
+            }
+            if (!visible) {
+              if (culled)
+                ++n.culled;
+              else if (degenerate && cr.count == 3)
+                ++n.degenerate;  // zero area after snapping: sub-pixel sliver or edge-on
+              else
+                ++n.outside;
+            }
+          }
+        }
+      });
+  std::vector<TriangleSetup> setups;
+  for (Chunk& c : chunks) {
+    setups.insert(setups.end(), c.out.begin(), c.out.end());
+    counters->trianglesIn += c.counters.trianglesIn;
+    counters->degenerate += c.counters.degenerate;
+    counters->culled += c.counters.culled;
+    counters->outside += c.counters.outside;
+    counters->clipped += c.counters.clipped;
+    counters->fromClipping += c.counters.fromClipping;
+    counters->guardBandClipped += c.counters.guardBandClipped;
+  }
+  return setups;
+}
+
+}  // namespace rastray

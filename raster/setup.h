@@ -1,0 +1,144 @@
+// Triangle setup: fixed-point snapping, integer edge functions with the
+// top-left fill rule, and the screen-space planes of depth, 1/w and the
+// perspective-divided barycentrics.
+//
+// Fixed point. Vertices snap to 1/256 pixel (kSubpixelBits = 8). Samples
+// must lie exactly on the same integer grid, so coordinates are kept in
+// units of 1/(256·k) pixel, where k is the smallest integer that puts
+// every sample position of the pattern on the grid: 1 for the Direct3D
+// patterns (multiples of 1/16) and for n×n grids with 2n dividing 256,
+// else 2n / gcd(2n, 256) (e.g. 5×5: k = 5).
+//
+// Overflow. Vertex and sample coordinates are clamped to |X|, |Y| <= L =
+// 2^29 units (kMaxCoordinateUnits) measured from the image's top-left
+// corner, i.e. 2^21 / k pixels: the largest safe coordinate is ±2,097,152
+// pixels for k = 1. An edge function E(p) = a·px + b·py + c has |a|, |b|
+// <= 2L = 2^30 (coordinate differences) and |c| = |a·x0 + b·y0| <= 2^60,
+// so |a·px + b·py| <= 2^60 and |E| <= 2^61 < 2^63: every evaluation and
+// every incremental step in int64 is exact. The guard band keeps vertices
+// inside ±(2^21/k − 2) pixels (clip.h clips x/y beyond it), and the image
+// itself must fit: W, H <= 2^20 / k (checked by makeSampleGrid).
+//
+// Orientation and fill rule. Image space has y down. Setup orders the
+// vertices so that twice the signed area (x1−x0)(y2−y0) − (y1−y0)(x2−x0) is
+// positive (clockwise as seen on screen); then inside means E >= 0 for all
+// three edges E_ij(p) = (xj−xi)(py−yi) − (yj−yi)(px−xi). A sample exactly on
+// an edge (E = 0) is covered only when the edge is
+//   top:  horizontal (yj == yi) with xj > xi, the triangle below it (y larger),
+//   left: yj < yi (the edge goes up the screen; the triangle lies to its right),
+// which is the Direct3D/OpenGL top-left convention in y-down coordinates.
+// Implemented as E + bias >= 0 with bias 0 for top-left edges and −1 else.
+// Front-facing (CCW in world, seen from the front) triangles have negative
+// area before the reordering: CCW with y up is clockwise with y down.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "common/scene.h"
+#include "raster/clip.h"
+#include "raster/rasterizer.h"
+
+namespace rastray {
+
+constexpr int kSubpixelBits = 8;
+constexpr int64_t kMaxCoordinateUnits = int64_t(1) << 29;
+
+// Sample positions of a pattern on the fixed-point grid.
+struct SampleGrid {
+  int spp = 1;
+  int64_t k = 1;  // grid refinement over 1/256 pixel
+  int64_t unitsPerPixel = 256;
+  std::vector<glm::i64vec2> offsets;  // sample offsets from the pixel corner, units
+  std::vector<glm::dvec2> positions;  // the same in pixels (common/sampling.h)
+  double safePixels = 0.0;            // largest safe |coordinate| in pixels
+  double guardPixels = 0.0;           // beyond the image edges before x/y clipping
+};
+
+// Throws InputError for an unsupported sample count or an image too large
+// for the fixed-point range.
+SampleGrid makeSampleGrid(int spp, int width, int height);
+
+// An affine function of the image position (pixels): value at (x, y) =
+// v0 + dx·(x − x0) + dy·(y − y0).
+struct Plane {
+  double v0 = 0.0, dx = 0.0, dy = 0.0;
+  double x0 = 0.0, y0 = 0.0;
+  double at(double x, double y) const { return v0 + dx * (x - x0) + dy * (y - y0); }
+};
+
+struct EdgeFunction {
+  int64_t a = 0, b = 0, c = 0;  // E(p) = a·px + b·py + c, p in units
+  int64_t bias = 0;             // 0 for top-left edges, −1 else
+  bool topLeft = false;
+  bool original = false;  // lies on an edge of the original (unclipped) triangle
+  int64_t at(int64_t px, int64_t py) const { return a * px + b * py + c; }
+};
+
+struct TriangleSetup {
+  uint32_t instance = 0, triangle = 0;
+  uint32_t parent = 0;                   // index of the source triangle in the scene store
+  glm::i64vec2 vertex[3];                // snapped, units
+  glm::dvec3 bary[3];                    // weights of the original stored vertices, in setup order
+  EdgeFunction edge[3];                  // edge i runs vertex i → vertex (i+1) % 3
+  glm::ivec2 pixelMin{0}, pixelMax{-1};  // inclusive pixel bounds, clipped to the image
+  Plane depth;                           // window depth z (format space, polygon offset applied)
+  Plane invW, dOverW, b1OverW, b2OverW;
+  double maxDepthSlope = 0.0;  // max(|∂z/∂x|, |∂z/∂y|) before offset
+  bool frontFacing = true;
+  bool fromClipping = false;
+  double centroidDepth = 0.0;  // view depth of the ORIGINAL triangle's centroid (sorted mode)
+
+  uint64_t id() const { return (uint64_t(instance) << 32) | triangle; }
+  // Perspective-correct values at an image position.
+  double viewDepthAt(double x, double y) const { return dOverW.at(x, y) / invW.at(x, y); }
+  glm::dvec2 baryAt(double x, double y) const {
+    const double inv = 1.0 / invW.at(x, y);
+    return {b1OverW.at(x, y) * inv, b2OverW.at(x, y) * inv};
+  }
+};
+
+struct DepthSettings {
+  DepthFormat format = DepthFormat::FloatReversed;
+  Projection projection = Projection::Perspective;
+  double znear = 0.0, zfar = 0.0;
+  double offsetFactor = 0.0, offsetUnits = 0.0;
+};
+
+enum class SetupOutcome { Ok, Degenerate, Culled, Offscreen };  // Offscreen: no pixel of the image
+
+// Sets up one clipped triangle (three clip vertices with w > 0).
+// `cull`: which facing to drop (None keeps both).
+SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& depth,
+                           const ClipVertex v[3], CullMode cull, TriangleSetup* out);
+
+}  // namespace rastray
+
+namespace rastray {
+
+struct SetupCounters {
+  uint64_t trianglesIn = 0;
+  uint64_t degenerate = 0;        // zero area in world space or after snapping
+  uint64_t culled = 0;            // back/front-face culling
+  uint64_t outside = 0;           // trivially outside the view volume or the image
+  uint64_t clipped = 0;           // needed near/far or guard-band clipping
+  uint64_t fromClipping = 0;      // triangles made by clipping (fan pieces)
+  uint64_t guardBandClipped = 0;  // of the clipped, those beyond the guard band
+};
+
+// Which material classes to set up (Opaque covers OPAQUE and MASK).
+struct TriangleFilter {
+  bool opaque = true;
+  bool blend = true;
+};
+
+// Transform (world → view in double), clip and set up every triangle of the
+// scene that passes `filter`, in scene order (instance, triangle; clipped
+// pieces in fan order), independently of the thread count. `cull` applies
+// to single-sided materials only.
+std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
+                                            const SampleGrid& grid, const DepthSettings& depth, CullMode cull,
+                                            TriangleFilter filter, SetupCounters* counters);
+
+}  // namespace rastray

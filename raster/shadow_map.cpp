@@ -1,0 +1,180 @@
+#include "raster/shadow_map.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace rastray {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr DepthFormat kMapFormat = DepthFormat::FloatReversed;
+
+// A camera at `eye` looking along `forward`.
+Camera lightCamera(const glm::dvec3& eye, const glm::dvec3& forward, int size) {
+  Camera c;
+  c.width = c.height = size;
+  c.aspect = 1.0;
+  glm::dvec3 up = std::abs(forward.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, up));
+  up = glm::cross(right, forward);
+  c.worldFromView = glm::dmat4(glm::dvec4(right, 0.0), glm::dvec4(up, 0.0), glm::dvec4(-forward, 0.0),
+                               glm::dvec4(eye, 1.0));
+  c.viewFromWorld = glm::inverse(c.worldFromView);
+  return c;
+}
+
+}  // namespace
+
+ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const Shader* shader)
+    : scene_(scene) {
+  const int size = options.shadowMapSize;
+  glm::dvec3 centre(0.0);
+  double radius = 1.0;
+  if (!scene.bounds.empty()) {
+    centre = 0.5 * (scene.bounds.lo + scene.bounds.hi);
+    radius = std::max(1e-6, 0.5 * glm::length(scene.bounds.hi - scene.bounds.lo));
+  }
+  perLight_.resize(scene.lights.size());
+  for (size_t l = 0; l < scene.lights.size(); ++l) {
+    const Light& light = scene.lights[l];
+    std::vector<Camera> cameras;
+    if (light.type == LightType::Directional) {
+      Camera c = lightCamera(centre - light.direction * (2.0 * radius), light.direction, size);
+      c.projection = Projection::Orthographic;
+      c.xmag = c.ymag = radius * 1.001;
+      c.znear = 0.0;
+      c.zfar = 4.0 * radius;
+      cameras.push_back(c);
+    } else {
+      // Near plane: small against the scene, far: infinite.
+      const double znear = std::max(1e-6, 1e-4 * radius);
+      std::vector<std::pair<glm::dvec3, double>> views;  // direction, yfov
+      if (light.type == LightType::Spot)
+        views.push_back({light.direction, std::min(2.0 * double(light.outerConeAngle) + 0.01, kPi * 0.95)});
+      else
+        for (const glm::dvec3& d : {glm::dvec3(1, 0, 0), glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0),
+                                    glm::dvec3(0, -1, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, 0, -1)})
+          // A hair over 90° so that the faces overlap at their seams.
+          views.push_back({d, kPi / 2.0 + 2.0 / size});
+      for (const auto& [dir, fov] : views) {
+        Camera c = lightCamera(light.position, dir, size);
+        c.projection = Projection::Perspective;
+        c.yfov = fov;
+        c.znear = znear;
+        c.zfar = std::numeric_limits<double>::infinity();
+        cameras.push_back(c);
+      }
+    }
+    for (const Camera& c : cameras) {
+      const SampleGrid grid = makeSampleGrid(1, size, size);
+      Map map{c, makeClipSpace(c, grid.guardPixels), DepthTarget(size, size, 1, true)};
+      DepthSettings ds{
+          kMapFormat, c.projection, c.znear, c.zfar, options.shadowBiasSlope, options.shadowBiasConstant};
+      SetupCounters counters;
+      const std::vector<TriangleSetup> setups =
+          prepareTriangles(scene, map.space, grid, ds, CullMode::None, {true, true}, &counters);
+      triangles_ += counters.trianglesIn;
+      const TileGrid tiles(size, size);
+      // BLEND and refractive surfaces attenuate instead of blocking (with a
+      // shader to ask how much); everything else writes depth.
+      const auto transmissive = [&](const TriangleSetup& t) {
+        const Material& m = scene.materialOf(t.instance);
+        return shader && (m.alphaMode == AlphaMode::Blend || m.isRefractive());
+      };
+      const auto bins = binTriangles(tiles, setups, [&](const TriangleSetup& t) { return !transmissive(t); });
+      const auto transmissiveBins = binTriangles(tiles, setups, transmissive);
+      const auto surfaceAt = [&](const TriangleSetup& t, int px, int py, int s) {
+        const glm::dvec2 pos = glm::dvec2(px, py) + grid.positions[size_t(s)];
+        const glm::dvec2 b = t.baryAt(pos.x, pos.y);
+        SampleHit hit{t.instance, t.triangle, float(t.viewDepthAt(pos.x, pos.y)), float(b.x), float(b.y)};
+        return makeSurfacePoint(scene, refineHit(scene, c.primaryRay(pos), hit));
+      };
+      std::function<bool(const TriangleSetup&, int, int, int)> alphaTest;
+      if (shader)
+        alphaTest = [&](const TriangleSetup& t, int px, int py, int s) {
+          const Material& m = scene.materialOf(t.instance);
+          if (m.alphaMode != AlphaMode::Mask) return true;
+          return shader->coverageAlpha(surfaceAt(t, px, py, s), TextureFootprint{}) >= m.alphaCutoff;
+        };
+      std::vector<std::vector<Attenuation>> perTile(size_t(tiles.count()));
+      tbb::parallel_for(0, tiles.count(), [&](int tile) {
+        DepthPassCounters dc;
+        const TileRect rect = tiles.rect(tile);
+        rasterDepthPass(setups, bins[size_t(tile)], grid, rect, kMapFormat, DepthFunc::Less, alphaTest,
+                        nullptr, &map.depth, &dc);
+        // Attenuating fragments in front of the opaque depth, kept per texel.
+        CoverageScratch scratch;
+        for (uint32_t index : transmissiveBins[size_t(tile)]) {
+          const TriangleSetup& t = setups[index];
+          // Untextured: the transmittance is the material's, the same everywhere.
+          const Material& m = scene.materialOf(t.instance);
+          const bool constant = m.baseColorTexture < 0;
+          SurfacePoint any;
+          any.material = &m;
+          const glm::vec3 uniform = constant ? shader->shadowTransmittance(any) : glm::vec3(1.0f);
+          forEachCoveredSample(t, grid, rect, scratch, [&](int px, int py, int s) {
+            const size_t texel = map.depth.index(px, py, 0);
+            const uint32_t key = sampleDepthKey(t, grid, kMapFormat, px, py, s);
+            if (key >= map.depth.keys[texel]) return;
+            const glm::vec3 pass = constant ? uniform : shader->shadowTransmittance(surfaceAt(t, px, py, s));
+            perTile[size_t(tile)].push_back({uint32_t(texel), key, pass});
+          });
+        }
+      });
+      for (const auto& v : perTile) map.attenuation.insert(map.attenuation.end(), v.begin(), v.end());
+      std::sort(map.attenuation.begin(), map.attenuation.end(),
+                [](const Attenuation& a, const Attenuation& b) {
+                  return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
+                });
+      attenuating_ += map.attenuation.size();
+      perLight_[l].push_back(std::move(map));
+    }
+  }
+  for (const auto& maps : perLight_)
+    for (const Map& m : maps) maps_.push_back(&m);
+}
+
+glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world) const {
+  const glm::dvec3 view(map.camera.viewFromWorld * glm::dvec4(world, 1.0));
+  const ClipVertex v = map.space.project(view, glm::dvec3(0.0));
+  const glm::vec3 one(1.0f);
+  if (!(v.position.z > map.camera.znear) || v.position.w <= 0.0) return one;  // behind the map: unshadowed
+  const glm::dvec2 image = map.space.imageOf(v.position);
+  const int x = int(std::floor(image.x)), y = int(std::floor(image.y));
+  if (x < 0 || y < 0 || x >= map.depth.width || y >= map.depth.height) return one;
+  const double z =
+      windowDepth(kMapFormat, map.camera.projection, map.camera.znear, map.camera.zfar, v.position.z);
+  const uint32_t key = depthKey(kMapFormat, z);
+  const uint32_t texel = uint32_t(map.depth.index(x, y, 0));
+  if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
+  // Attenuation by the transmissive layers between the light and the point.
+  glm::vec3 t = one;
+  auto it = std::lower_bound(map.attenuation.begin(), map.attenuation.end(), texel,
+                             [](const Attenuation& a, uint32_t tx) { return a.texel < tx; });
+  for (; it != map.attenuation.end() && it->texel == texel && it->key < key; ++it) t *= it->transmittance;
+  return t;
+}
+
+glm::vec3 ShadowMaps::transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
+                                    double) const {
+  const std::vector<Map>& maps = perLight_[size_t(lightIndex)];
+  if (maps.empty()) return glm::vec3(1.0f);
+  if (maps.size() == 1) return lit(maps[0], point.position);
+  // Cube map: the face of the major axis of the direction from the light.
+  const glm::dvec3 d = -toLight;
+  const glm::dvec3 a = glm::abs(d);
+  int face;
+  if (a.x >= a.y && a.x >= a.z)
+    face = d.x > 0 ? 0 : 1;
+  else if (a.y >= a.z)
+    face = d.y > 0 ? 2 : 3;
+  else
+    face = d.z > 0 ? 4 : 5;
+  return lit(maps[size_t(face)], point.position);
+}
+
+}  // namespace rastray
