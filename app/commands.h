@@ -13,6 +13,7 @@ using CommandRunner = std::function<int()>;
 CommandRunner addInfoCommand(CLI::App& app);
 CommandRunner addRenderCommand(CLI::App& app);
 CommandRunner addCrossvalCommand(CLI::App& app);
+CommandRunner addExplainCommand(CLI::App& app);
 CommandRunner addCompareCommand(CLI::App& app);
 
 }  // namespace rastray

@@ -15,6 +15,8 @@
 #include "app/commands.h"
 #include "app/crossval.h"
 #include "app/crossval_report.h"
+#include "app/explain.h"
+#include "common/image.h"
 #include "app/render_setup.h"
 #include "common/error.h"
 
@@ -92,7 +94,27 @@ int runCrossval(CrossvalOptions& opt) {
                          std::to_string(opt.maxHybridError) + ")");
   }
 
-  if (!opt.reportDir.empty()) writeCrossvalReport(opt.reportDir, results, opt.settings, {});
+  if (!opt.reportDir.empty()) {
+    // One explained example pixel per mismatch class, linked from the report.
+    std::vector<std::vector<ReportExplanation>> explanations(results.size());
+    for (size_t i = 0; i < results.size(); ++i) {
+      const CrossvalResult& r = results[i];
+      const std::string folder =
+          opt.reportDir + "/" + std::filesystem::path(r.scenePath).stem().string();
+      std::filesystem::create_directories(folder);
+      const Scene scene = loadScene(r.scenePath);
+      for (int c = 0; c < kMismatchClassCount; ++c) {
+        const auto& example = r.rasterVsRay.examples[size_t(c)];
+        if (!example) continue;
+        if (terminal) std::fprintf(stderr, "\rexplaining %s: %-20s", r.scenePath.c_str(), toString(MismatchClass(c)));
+        const std::string file = std::string("explain-") + toString(MismatchClass(c)) + ".txt";
+        writeTextFile(folder + "/" + file, explainPixel(scene, opt.settings, example->x, example->y));
+        explanations[i].push_back({toString(MismatchClass(c)), file});
+      }
+    }
+    if (terminal) std::fprintf(stderr, "\r%80s\r", "");
+    writeCrossvalReport(opt.reportDir, results, opt.settings, explanations);
+  }
 
   if (opt.json) {
     nlohmann::json j = nlohmann::json::array();

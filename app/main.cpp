@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
 #ifdef RASTRAY_HAVE_RENDERERS
   commands.push_back(addRenderCommand(app));
   commands.push_back(addCrossvalCommand(app));
+  commands.push_back(addExplainCommand(app));
 #endif
   commands.push_back(addCompareCommand(app));
 
