@@ -13,6 +13,11 @@ using json = nlohmann::json;
 
 constexpr double kPi = 3.14159265358979323846;
 
+// An accessor without a bufferView (zeros, or sparse over zeros) costs
+// memory but no file bytes; this bound keeps a hostile "count" from
+// allocating gigabytes while leaving far more than any real use.
+constexpr int64_t kMaxZeroFilledElements = int64_t(1) << 24;
+
 constexpr const char* kSupportedExtensions[] = {
     "KHR_lights_punctual",          "KHR_materials_transmission",
     "KHR_materials_ior",            "KHR_materials_emissive_strength",
@@ -292,6 +297,10 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       const int64_t count = c.integer(a, "count", e, true);
       if (count < 1) c.fail(e, "\"count\" must be at least 1");
       if (count > (int64_t(1) << 32)) c.fail(e, "\"count\" " + std::to_string(count) + " is too large");
+      if (view < 0 && count > kMaxZeroFilledElements)
+        c.fail(e, "\"count\" " + std::to_string(count) +
+                      " is too large for an accessor without a bufferView (at most " +
+                      std::to_string(kMaxZeroFilledElements) + ")");
       const std::string type = c.string(a, "type", e, true);
       const int64_t components = componentCount(type);
       if (components == 0) c.fail(e, "\"type\" \"" + type + "\" is not a glTF accessor type");
@@ -375,6 +384,7 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
     for (size_t i = 0; i < materials->size(); ++i) {
       const std::string e = "material " + std::to_string(i);
       const json& m = c.object((*materials)[i], e);
+      c.string(m, "name", e, false);
       if (const json* pbr = c.member(m, "pbrMetallicRoughness")) {
         const std::string pe = e + " pbrMetallicRoughness";
         c.object(*pbr, pe);
@@ -481,6 +491,7 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
         for (size_t i = 0; i < lights->size(); ++i) {
           const std::string e = "light " + std::to_string(i);
           const json& l = c.object((*lights)[i], e);
+          c.string(l, "name", e, false);
           const std::string type = c.string(l, "type", e, true);
           if (type != "point" && type != "spot" && type != "directional")
             c.fail(e, "\"type\" \"" + type + "\" is not point, spot or directional");
@@ -505,6 +516,7 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
     for (size_t i = 0; i < nodes->size(); ++i) {
       const std::string e = "node " + std::to_string(i);
       const json& n = c.object((*nodes)[i], e);
+      c.string(n, "name", e, false);
       c.index(n, "camera", e, "cameras");
       c.index(n, "mesh", e, "meshes");
       c.index(n, "skin", e, "skins");

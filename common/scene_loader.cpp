@@ -50,9 +50,137 @@ std::string firstLine(const std::string& text) {
   return "unknown error";
 }
 
+// Keeps a message from tinygltf readable on one line: data URIs can be
+// megabytes long.
+std::string shortened(std::string text) {
+  constexpr size_t kMaxLength = 200;
+  if (text.size() > kMaxLength) text = text.substr(0, kMaxLength) + "...";
+  return text;
+}
+
+// The glTF top-level arrays whose entries messages name as elements.
+constexpr const char* kElementArrays[] = {"accessors", "animations", "buffers", "bufferViews",
+                                          "cameras",   "images",     "materials", "meshes",
+                                          "nodes",     "samplers",   "scenes",    "skins",
+                                          "textures"};
+
+// "nodes" -> "node"; empty for a key that is not one of kElementArrays.
+std::string singular(const std::string& key) {
+  for (const char* plural : kElementArrays)
+    if (key == plural) return key == "meshes" ? "mesh" : key.substr(0, key.size() - 1);
+  return "";
+}
+
+// A real glTF nests about ten levels (material > extensions > texture info
+// > extensions > ...); tinygltf copies "extras" and "extensions" with a
+// recursive function, so a deeper document could overflow the stack.
+constexpr size_t kMaxJsonDepth = 64;
+
+// nlohmann's DOM parser, plus where it is in the document (for messages
+// about syntax errors and numbers that overflow a double, which have no
+// element yet) and a nesting limit.
+class TrackingJsonParser : public nlohmann::detail::json_sax_dom_parser<json> {
+  using Base = nlohmann::detail::json_sax_dom_parser<json>;
+
+ public:
+  TrackingJsonParser(json& document, const std::string& path, const std::string& text)
+      : Base(document, true), path_(path), text_(text) {}
+
+  bool null() { return value(), Base::null(); }
+  bool boolean(bool v) { return value(), Base::boolean(v); }
+  bool number_integer(json::number_integer_t v) { return value(), Base::number_integer(v); }
+  bool number_unsigned(json::number_unsigned_t v) { return value(), Base::number_unsigned(v); }
+  bool number_float(json::number_float_t v, const std::string& s) {
+    return value(), Base::number_float(v, s);
+  }
+  bool string(std::string& v) { return value(), Base::string(v); }
+  bool binary(json::binary_t& v) { return value(), Base::binary(v); }
+  bool start_object(size_t n) { return open(false), Base::start_object(n); }
+  bool key(std::string& k) {
+    frames_.back().key = k;
+    return Base::key(k);
+  }
+  bool end_object() { return frames_.pop_back(), Base::end_object(); }
+  bool start_array(size_t n) { return open(true), Base::start_array(n); }
+  bool end_array() { return frames_.pop_back(), Base::end_array(); }
+
+  template <class Exception>
+  bool parse_error(size_t position, const std::string&, const Exception& ex) {
+    // ex.what(): "[json.exception.KIND.ID] [parse error at line L, column C: ]DETAIL".
+    std::string detail = ex.what();
+    size_t at = detail.find("] ");
+    if (at != std::string::npos) detail.erase(0, at + 2);
+    if (detail.rfind("parse error", 0) == 0 && (at = detail.find(": ")) != std::string::npos)
+      detail.erase(0, at + 2);
+    // Line and column as nlohmann counts them: `position` characters read.
+    size_t line = 1, column = 0;
+    for (size_t i = 0; i < position && i < text_.size(); ++i) {
+      column = text_[i] == '\n' ? 0 : column + 1;
+      line += text_[i] == '\n';
+    }
+    throw InputError(path_, element(), "invalid JSON at line " + std::to_string(line) +
+                                           ", column " + std::to_string(column) + where() +
+                                           ": " + detail);
+  }
+
+ private:
+  struct Frame {
+    bool isArray = false;
+    std::string key;   // objects: the last key read
+    size_t count = 0;  // arrays: elements begun so far
+  };
+
+  void value() {
+    if (!frames_.empty() && frames_.back().isArray) ++frames_.back().count;
+  }
+  void open(bool isArray) {
+    value();
+    if (frames_.size() >= kMaxJsonDepth)
+      throw InputError(path_, element(), "JSON nesting is deeper than " +
+                                             std::to_string(kMaxJsonDepth) + " levels");
+    frames_.push_back({isArray, "", 0});
+  }
+  // Position of frame i's current member: a key, or the index of the
+  // element begun last (the next one, for the innermost array).
+  std::string step(size_t i) const {
+    const Frame& f = frames_[i];
+    if (!f.isArray) return f.key;
+    return std::to_string(i + 1 == frames_.size() ? f.count : f.count - 1);
+  }
+  // Whether the path starts in an entry of a glTF array ("nodes"[3]).
+  bool inArrayEntry() const {
+    return frames_.size() >= 2 && frames_[1].isArray && !singular(frames_[0].key).empty();
+  }
+  // The glTF element: "node 3" for the root's "nodes"[3], else the top-level key.
+  std::string element() const {
+    if (frames_.empty() || frames_[0].isArray) return "";
+    if (inArrayEntry()) return singular(frames_[0].key) + " " + step(1);
+    return frames_[0].key;
+  }
+  // The rest of the path inside the element, e.g. ' ("matrix"[12])'.
+  std::string where() const {
+    std::string s;
+    for (size_t i = inArrayEntry() ? 2 : 1; i < frames_.size(); ++i)
+      s += frames_[i].isArray ? "[" + step(i) + "]"
+                              : (s.empty() ? "" : ".") + ("\"" + step(i) + "\"");
+    return s.empty() ? s : " (" + s + ")";
+  }
+
+  const std::string& path_;
+  const std::string& text_;
+  std::vector<Frame> frames_;
+};
+
 // tinygltf's default ExpandFilePath is a no-op on modern versions; ours
 // states it: URIs are file names relative to the glTF file, nothing more.
 std::string expandNothing(const std::string& path, void*) { return path; }
+
+// Only regular files count as found: tinygltf would take the seek size of
+// a directory (2^63 - 1 on some file systems) as its length.
+bool isRegularFile(const std::string& path, void*) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
 
 class SceneBuilder {
  public:
@@ -404,10 +532,12 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
   const double sign = inst.mirrored ? -1.0 : 1.0;
   for (size_t v = 0; v < vertexCount; ++v) {
     const glm::dvec3 p = glm::dvec3(world * glm::dvec4(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2], 1.0));
-    const glm::vec3 pf(p);
-    if (!std::isfinite(pf.x) || !std::isfinite(pf.y) || !std::isfinite(pf.z))
+    // Test in double: converting a value beyond the float range is undefined.
+    constexpr double kFloatMax = std::numeric_limits<float>::max();
+    if (!(std::abs(p.x) <= kFloatMax && std::abs(p.y) <= kFloatMax && std::abs(p.z) <= kFloatMax))
       fail(e + " POSITION (accessor " + std::to_string(posAccessor) + ")",
            "vertex " + std::to_string(v) + " is not finite in world space as float");
+    const glm::vec3 pf(p);
     scene_.positions.push_back(pf);
     scene_.bounds.extend(glm::dvec3(pf));
     glm::dvec3 n(0.0);
@@ -533,7 +663,9 @@ void SceneBuilder::loadTextures() {
     const size_t pixels = size_t(std::max(src.width, 0)) * size_t(std::max(src.height, 0));
     if (src.width <= 0 || src.height <= 0 || comps < 1 || comps > 4 || (bytes != 1 && bytes != 2) ||
         src.image.size() < pixels * size_t(comps * bytes))
-      fail("image " + std::to_string(i), "could not be decoded to 8- or 16-bit pixels");
+      fail("image " + std::to_string(i), src.image.empty() && !src.uri.empty()
+                                             ? "\"" + shortened(src.uri) + "\" could not be read"
+                                             : "could not be decoded to 8- or 16-bit pixels");
     img.rgba8.resize(pixels * 4);
     for (size_t p = 0; p < pixels; ++p) {
       uint8_t c[4] = {0, 0, 0, 255};
@@ -666,35 +798,44 @@ Scene loadScene(const std::string& path) {
     if (jsonType != kChunkJson) throw InputError(path, "GLB chunk 0", "is not a JSON chunk");
     if (jsonLength > bytes.size() - 20)
       throw InputError(path, "GLB chunk 0", "length " + std::to_string(jsonLength) + " runs past the end of the file");
+    // Chunks end on 4-byte boundaries (glTF 2.0, GLB layout); tinygltf
+    // looks for the BIN chunk right after the JSON bytes, so an unpadded
+    // length would have it read another chunk than the one checked here.
+    if (jsonLength % 4 != 0)
+      throw InputError(path, "GLB chunk 0",
+                       "length " + std::to_string(jsonLength) + " is not a multiple of 4");
     jsonText.assign(reinterpret_cast<const char*>(bytes.data() + 20), jsonLength);
-    const size_t binAt = 20 + ((size_t(jsonLength) + 3) & ~size_t(3));
-    if (binAt + 8 <= bytes.size()) {
+    // Whatever follows must be a BIN chunk: tinygltf refuses anything else.
+    const size_t binAt = 20 + size_t(jsonLength);
+    if (binAt < bytes.size()) {
+      if (bytes.size() - binAt < 8)
+        throw InputError(path, "GLB chunk 1",
+                         "header is truncated (" + std::to_string(bytes.size() - binAt) +
+                             " bytes after the JSON chunk)");
       const uint32_t binLength = readU32(bytes, binAt), binType = readU32(bytes, binAt + 4);
-      if (binType == kChunkBin) {
-        if (binLength > bytes.size() - binAt - 8)
-          throw InputError(path, "GLB chunk 1", "length " + std::to_string(binLength) + " runs past the end of the file");
-        context.glbBinSize = binLength;
-      }
+      if (binType != kChunkBin) throw InputError(path, "GLB chunk 1", "is not a BIN chunk");
+      if (binLength < 4 || binLength % 4 != 0)
+        throw InputError(path, "GLB chunk 1",
+                         "length " + std::to_string(binLength) + " is not a positive multiple of 4");
+      if (binLength > bytes.size() - binAt - 8)
+        throw InputError(path, "GLB chunk 1",
+                         "length " + std::to_string(binLength) + " runs past the end of the file");
+      context.glbBinSize = binLength;
     }
   } else {
     jsonText.assign(bytes.begin(), bytes.end());
   }
 
   json doc;
-  try {
-    doc = json::parse(jsonText);
-  } catch (const json::parse_error& e) {
-    std::string what = e.what();
-    const size_t at = what.find("] ");
-    throw InputError(path, "", "invalid JSON: " + (at == std::string::npos ? what : what.substr(at + 2)));
-  }
+  TrackingJsonParser parser(doc, path, jsonText);
+  json::sax_parse(jsonText, &parser);
   checkGltfDocument(doc, context);
 
   // Resources through tinygltf. The document is sound by now, so its
   // remaining failures are about resources: missing files, bad data URIs,
   // undecodable images.
   tinygltf::TinyGLTF loader;
-  tinygltf::FsCallbacks fs{&tinygltf::FileExists, &expandNothing, &tinygltf::ReadWholeFile,
+  tinygltf::FsCallbacks fs{&isRegularFile, &expandNothing, &tinygltf::ReadWholeFile,
                            &tinygltf::WriteWholeFile, nullptr};
   loader.SetFsCallbacks(fs);
   tinygltf::Model model;
@@ -706,7 +847,33 @@ Scene loadScene(const std::string& path) {
                                                     baseDir.empty() ? "." : baseDir)
                       : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(), unsigned(jsonText.size()),
                                                    baseDir.empty() ? "." : baseDir);
-  if (!ok) throw InputError(path, "", firstLine(err));
+  if (!ok) {
+    // tinygltf loads the top-level arrays in this order and appends each
+    // entry once it has loaded, so the first array that came up short
+    // holds the entry it failed on.
+    const std::pair<const char*, size_t> loaded[] = {
+        {"buffers", model.buffers.size()},     {"bufferViews", model.bufferViews.size()},
+        {"accessors", model.accessors.size()}, {"meshes", model.meshes.size()},
+        {"nodes", model.nodes.size()},         {"scenes", model.scenes.size()},
+        {"materials", model.materials.size()}, {"images", model.images.size()},
+        {"textures", model.textures.size()},   {"animations", model.animations.size()},
+        {"skins", model.skins.size()},         {"samplers", model.samplers.size()},
+        {"cameras", model.cameras.size()}};
+    for (const auto& [key, count] : loaded) {
+      const auto it = doc.find(key);
+      if (it == doc.end() || !it->is_array() || count >= it->size()) continue;
+      const json& entry = (*it)[count];
+      std::string message = shortened(firstLine(err));
+      // tinygltf's message would quote the whole data URI.
+      const bool dataUri = entry.value("uri", std::string()).rfind("data:", 0) == 0;
+      if (std::string(key) == "buffers" && dataUri)
+        message = "data URI is not base64 of exactly byteLength (" +
+                  std::to_string(entry.at("byteLength").get<uint64_t>()) +
+                  ") bytes with media type application/octet-stream or application/gltf-buffer";
+      throw InputError(path, singular(key) + " " + std::to_string(count), message);
+    }
+    throw InputError(path, "", shortened(firstLine(err)));
+  }
   if (model.buffers.size() != doc.value("buffers", json::array()).size() ||
       model.images.size() != doc.value("images", json::array()).size())
     throw InputError(path, "", "tinygltf loaded a different number of buffers or images than the file lists");
