@@ -101,6 +101,44 @@ void checkIds(const LayeredFrame& f, const Scene& scene, const std::string& name
 
 uint64_t packId(const HitRecord& h) { return (uint64_t(h.instance) << 32) | h.triangle; }
 
+// Aligns two front-to-back layer lists by a longest common subsequence of
+// their (instance, triangle) keys. Returns index pairs in order; an index
+// equal to the list's size stands for "nothing". Lists are a few layers
+// long, so the quadratic table is cheap.
+std::vector<std::pair<size_t, size_t>> alignLayers(const HitRecord* a, size_t na, const HitRecord* b, size_t nb) {
+  std::vector<std::pair<size_t, size_t>> out;
+  if (na == 0 && nb == 0) {
+    out.emplace_back(0, 0);  // both empty: one empty layer agrees
+    return out;
+  }
+  std::vector<size_t> lcs((na + 1) * (nb + 1), 0);
+  auto at = [&](size_t i, size_t j) -> size_t& { return lcs[i * (nb + 1) + j]; };
+  for (size_t i = na; i-- > 0;)
+    for (size_t j = nb; j-- > 0;)
+      at(i, j) = a[i].sameSurface(b[j]) ? at(i + 1, j + 1) + 1 : std::max(at(i + 1, j), at(i, j + 1));
+  size_t i = 0, j = 0;
+  std::vector<size_t> onlyA, onlyB;
+  auto flush = [&]() {
+    const size_t n = std::max(onlyA.size(), onlyB.size());
+    for (size_t k = 0; k < n; ++k)
+      out.emplace_back(k < onlyA.size() ? onlyA[k] : na, k < onlyB.size() ? onlyB[k] : nb);
+    onlyA.clear();
+    onlyB.clear();
+  };
+  while (i < na || j < nb) {
+    if (i < na && j < nb && a[i].sameSurface(b[j])) {
+      flush();
+      out.emplace_back(i++, j++);
+    } else if (j >= nb || (i < na && at(i + 1, j) >= at(i, j + 1))) {
+      onlyA.push_back(i++);
+    } else {
+      onlyB.push_back(j++);
+    }
+  }
+  flush();
+  return out;
+}
+
 // IDs in the 3×3 neighbourhood of a pixel, all samples and layers; kNoId
 // for a sample with no hit.
 std::vector<uint64_t> neighbourhoodIds(const LayeredFrame& f, int x, int y) {
@@ -153,19 +191,17 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
       PixelVisibility& vis = r.pixels[pixel];
       for (int s = 0; s < fa.slots; ++s) {
         const size_t slot = fa.slot(x, y, s);
-        const size_t na = fa.layerCount(slot), nb = fb.layerCount(slot);
-        const size_t layers = std::max<size_t>({na, nb, 1});
-        for (size_t k = 0; k < layers; ++k) {
-          const HitRecord& a = k < na ? fa.begin(slot)[k] : empty;
-          const HitRecord& b = k < nb ? fb.begin(slot)[k] : empty;
-          AgreementCounts* counts[2] = {&r.layers, k == 0 ? &r.samples : nullptr};
+        const HitRecord* la = fa.begin(slot);
+        const HitRecord* lb = fb.begin(slot);
+        const glm::dvec2 position = glm::dvec2(x, y) + slotPositions[size_t(s)];
+        // Records one compared pair (a layer, or the sample's front layers).
+        auto record = [&](const HitRecord& a, const HitRecord& b, size_t layer, AgreementCounts& c,
+                          bool isLayer) {
+          ++c.compared;
           if (a.sameSurface(b)) {
-            for (AgreementCounts* c : counts)
-              if (c) {
-                ++c->compared;
-                ++c->agreeing;
-                c->bothEmpty += !a.isHit();
-              }
+            ++c.agreeing;
+            c.bothEmpty += !a.isHit();
+            if (!isLayer) return;
             vis = std::max(vis, a.isHit() ? PixelVisibility::Agree : PixelVisibility::BothEmpty);
             if (a.isHit() && std::isfinite(a.depth) && std::isfinite(b.depth)) {
               const double absolute = std::fabs(double(a.depth) - double(b.depth));
@@ -183,21 +219,28 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
               float& pe = r.pixelDepthError[pixel];
               if (std::isnan(pe) || float(absolute) > pe) pe = float(absolute);
             }
-            continue;
+            return;
           }
-          const glm::dvec2 position = glm::dvec2(x, y) + slotPositions[size_t(s)];
           const ImageSpaceEvidence evidence =
               classifier.geometric() ? ImageSpaceEvidence{} : imageSpaceEvidence(fa, fb, x, y, a, b);
           const MismatchClass cls = classifier.classify(position, a, b, evidence);
-          for (AgreementCounts* c : counts)
-            if (c) {
-              ++c->compared;
-              ++c->mismatches[size_t(cls)];
-            }
+          ++c.mismatches[size_t(cls)];
+          if (!isLayer) return;
           vis = std::max(vis, toPixelVisibility(cls));
           auto& example = r.examples[size_t(cls)];
-          if (!example) example = MismatchExample{x, y, slotSamples[size_t(s)], int(k), a, b};
-        }
+          if (!example) example = MismatchExample{x, y, slotSamples[size_t(s)], int(layer), a, b};
+        };
+        const size_t na = fa.layerCount(slot), nb = fb.layerCount(slot);
+        // The sample: its front surfaces.
+        record(na ? la[0] : empty, nb ? lb[0] : empty, 0, r.samples, false);
+        // The layers, aligned by (instance, triangle): a surface one
+        // renderer missed at an edge must not shift every layer behind it
+        // into a false mismatch. The alignment is a longest common
+        // subsequence of the two front-to-back lists; between matched
+        // layers, the unmatched ones are paired in order, and the rest are
+        // compared with nothing.
+        for (const auto& [ia, ib] : alignLayers(la, na, lb, nb))
+          record(ia < na ? la[ia] : empty, ib < nb ? lb[ib] : empty, std::min(ia, ib), r.layers, true);
       }
     }
   if (r.depth.count) {

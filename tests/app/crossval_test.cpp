@@ -1,0 +1,128 @@
+// crossval, its report and explain, through the real binary.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "run_command.h"
+
+namespace rastray {
+namespace {
+
+using nlohmann::json;
+using test::runRastray;
+
+std::string scene(const char* name) { return std::string(RASTRAY_SCENES) + "/" + name + ".gltf"; }
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Every bundled scene: zero genuine mismatches between the rasterizer and
+// the ray caster and between hybrid and the ray caster, and hybrid shades
+// exactly like the ray caster wherever their hits agree.
+TEST(Crossval, BundledScenesHaveNoGenuineMismatches) {
+  std::vector<std::string> args = {"crossval"};
+  for (const char* s : {"three-triangles", "interpenetrating", "cyclic-overlap", "cornell-box", "transparent-layers",
+                        "textured-plane"})
+    args.push_back(scene(s));
+  for (const char* a : {"--size", "96", "72", "--spp", "4", "--json", "--shadow-map-size", "512"}) args.push_back(a);
+  const auto r = runRastray(args);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const json j = json::parse(r.out);
+  ASSERT_EQ(j["scenes"].size(), 6u);
+  for (const json& s : j["scenes"]) {
+    for (const char* pair : {"rasterVsRaytrace", "hybridVsRaytrace"}) {
+      EXPECT_EQ(s[pair]["visibility"]["mismatches"]["genuine"], 0) << s["scene"] << " " << pair;
+      EXPECT_GT(s[pair]["visibility"]["layers"]["agreeing"].get<double>(),
+                0.99 * s[pair]["visibility"]["layers"]["compared"].get<double>())
+          << s["scene"] << " " << pair;
+    }
+    EXPECT_LE(s["hybridVsRaytrace"]["color"]["maxWhereHitsAgree"].get<double>(), 1e-5) << s["scene"];
+    // Depth agrees to float precision where the hits agree.
+    EXPECT_LT(s["rasterVsRaytrace"]["visibility"]["depthError"]["maxRelative"].get<double>(), 1e-5) << s["scene"];
+  }
+  EXPECT_TRUE(j["failures"].empty());
+}
+
+// Transparent layers: the ray caster's front-to-back compositing equals the
+// rasterizer's exact per-sample fragment lists (with traced shadows, so
+// both see the same light) to 1e-5 wherever the layer lists agree.
+TEST(Crossval, ExactTransparencyMatchesTheRayCaster) {
+  const auto r = runRastray({"crossval", scene("transparent-layers"), "--size", "120", "90", "--spp", "4", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json s = json::parse(r.out)["scenes"][0];
+  EXPECT_GT(s["hybridVsRaytrace"]["color"]["layersWhereHitsAgree"].get<uint64_t>(), 40000u);
+  EXPECT_LE(s["hybridVsRaytrace"]["color"]["maxWhereHitsAgree"].get<double>(), 1e-5);
+}
+
+TEST(Crossval, SortedTransparencyIsFlaggedAsWrongOnCyclicOverlap) {
+  // The painter's order cannot be right on a cyclic overlap: the layer
+  // order it reports disagrees with the ray caster's somewhere.
+  const auto r = runRastray({"crossval", scene("cyclic-overlap"), "--size", "120", "90", "--spp", "4",
+                             "--transparency", "sorted", "--json"});
+  ASSERT_EQ(r.status, 1) << r.out << r.err;
+  const json s = json::parse(r.out)["scenes"][0];
+  EXPECT_GT(s["rasterVsRaytrace"]["visibility"]["mismatches"]["genuine"].get<int>(), 0);
+}
+
+TEST(Crossval, ReportIsSelfContained) {
+  const std::string dir = "report_" + std::to_string(getpid());
+  const auto r = runRastray({"crossval", scene("cornell-box"), scene("three-triangles"), "--size", "80", "60",
+                             "--report", dir, "--shadow-map-size", "256"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(std::filesystem::exists(dir + "/index.html"));
+  for (const char* f : {"index.html", "raster.png", "raytrace.png", "hybrid.png", "mismatch.png", "depth-diff.png",
+                        "color-diff.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/cornell-box/" + f)) << f;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
+    if (entry.path().extension() != ".html") continue;
+    const std::string html = slurp(entry.path());
+    EXPECT_EQ(html.find("http://"), std::string::npos) << entry.path();
+    EXPECT_EQ(html.find("https://"), std::string::npos) << entry.path();
+    EXPECT_EQ(html.find("<script"), std::string::npos) << entry.path();
+  }
+  const std::string index = slurp(dir + "/index.html");
+  EXPECT_NE(index.find("cornell-box/index.html"), std::string::npos);
+  EXPECT_NE(index.find("three-triangles/index.html"), std::string::npos);
+
+  // A real browser renders the page (headless Chromium, when installed).
+  const char* chromium = "/usr/bin/chromium";
+  if (!std::filesystem::exists(chromium)) {
+    std::filesystem::remove_all(dir);
+    GTEST_SKIP() << "Chromium is not installed (apt-get install chromium): browser check skipped";
+  }
+  const std::string shot = std::filesystem::absolute(dir + "/shot.png").string();
+  const std::string profile = std::filesystem::absolute(dir + "/profile").string();
+  const std::string cmd = std::string(chromium) +
+                          " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
+                          "--disable-background-networking --disable-component-update --disable-sync "
+                          "--user-data-dir=" + profile + " --window-size=1200,1600 --screenshot=" + shot + " file://" +
+                          std::filesystem::absolute(dir + "/cornell-box/index.html").string() + " >/dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  ASSERT_TRUE(std::filesystem::exists(shot));
+  // A page that rendered its images is far from a blank screenshot.
+  EXPECT_GT(std::filesystem::file_size(shot), 20000u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Explain, ShowsBothRenderersAndTheirHits) {
+  const auto r = runRastray({"explain", scene("three-triangles"), "40", "40", "--size", "80", "80", "--spp", "4"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("== hits per sample"), std::string::npos);
+  EXPECT_NE(r.out.find("== rasterizer"), std::string::npos);
+  EXPECT_NE(r.out.find("edge 0:"), std::string::npos);
+  EXPECT_NE(r.out.find("== ray caster"), std::string::npos);
+  EXPECT_NE(r.out.find("sample 3"), std::string::npos);
+  EXPECT_EQ(runRastray({"explain", scene("three-triangles"), "80", "0", "--size", "80", "80"}).status, 2);
+}
+
+}  // namespace
+}  // namespace rastray
