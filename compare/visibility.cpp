@@ -105,7 +105,8 @@ uint64_t packId(const HitRecord& h) { return (uint64_t(h.instance) << 32) | h.tr
 // their (instance, triangle) keys. Returns index pairs in order; an index
 // equal to the list's size stands for "nothing". Lists are a few layers
 // long, so the quadratic table is cheap.
-std::vector<std::pair<size_t, size_t>> alignLayers(const HitRecord* a, size_t na, const HitRecord* b, size_t nb) {
+std::vector<std::pair<size_t, size_t>> alignLayers(const HitRecord* a, size_t na, const HitRecord* b,
+                                                   size_t nb) {
   std::vector<std::pair<size_t, size_t>> out;
   if (na == 0 && nb == 0) {
     out.emplace_back(0, 0);  // both empty: one empty layer agrees
