@@ -2,9 +2,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <ctime>
 #include <numeric>
 #include <random>
 
@@ -239,24 +237,6 @@ TEST(Textures, MipLevelGrowsTowardsTheHorizonOnTheGrazingPlane) {
     nearMax = std::max(nearMax, g);
   }
   EXPECT_GT(nearMax - nearMin, 0.2f);
-}
-
-TEST(Timing, CornellBox640x480At4Spp) {
-  const Scene scene = loadScene(scenePath("cornell-box.gltf"));
-  const Camera camera = sceneCamera(scene, 640, 480);
-  RasterOptions o;
-  o.spp = 4;  // default shadow maps: a 2048² cube map for the point light
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::clock_t c0 = std::clock();
-  const RenderOutput out = render(scene, camera, o);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
-  std::printf("cornell-box 640x480 4 spp: %.3f s wall, %.3f s CPU (all threads)\n", s, cpu);
-  for (const auto& [name, value] : out.counters.values)
-    std::printf("  %s %llu\n", name.c_str(), (unsigned long long)value);
-  for (const auto& [name, value] : out.timings) std::printf("  %s %.3f s\n", name.c_str(), value);
-  EXPECT_LT(s, 20.0);
-  EXPECT_GT(out.counters.get("raster.shadow_map_triangles"), 0u);
 }
 
 }  // namespace
