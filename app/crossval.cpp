@@ -35,7 +35,9 @@ uint32_t sampleCount(const DeepImage& image) {
   return spp;
 }
 
-StoredDepthFormat storedFormat(DepthFormat f) {
+}  // namespace
+
+StoredDepthFormat storedDepthFormat(DepthFormat f) {
   switch (f) {
     case DepthFormat::FloatReversed: return StoredDepthFormat::FloatReversed;
     case DepthFormat::Float: return StoredDepthFormat::Float;
@@ -44,8 +46,6 @@ StoredDepthFormat storedFormat(DepthFormat f) {
   }
   return StoredDepthFormat::FloatReversed;
 }
-
-}  // namespace
 
 AgreeingColorStats colorWhereHitsAgree(const DeepImage& a, const DeepImage& b) {
   AgreeingColorStats stats;
@@ -103,7 +103,7 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
 
   say("compare");
   ClassifierSettings classifier;
-  classifier.depthFormat = storedFormat(settings.raster.depthFormat);
+  classifier.depthFormat = storedDepthFormat(settings.raster.depthFormat);
   classifier.planes = {true, r.camera.projection, r.camera.znear, r.camera.zfar};
   classifier.scene = &scene;
   classifier.camera = &r.camera;

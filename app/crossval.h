@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "app/render_setup.h"
+#include "compare/classify.h"
 #include "compare/color_metrics.h"
 #include "compare/visibility.h"
 
@@ -21,6 +22,10 @@ struct AgreeingColorStats {
 };
 
 AgreeingColorStats colorWhereHitsAgree(const DeepImage& a, const DeepImage& b);
+
+// The compare tool's name for the rasterizer's depth format (compare/
+// knows neither renderer).
+StoredDepthFormat storedDepthFormat(DepthFormat format);
 
 struct CrossvalResult {
   std::string scenePath;

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/crossval.h"
 #include "common/error.h"
 #include "common/sampling.h"
 #include "compare/classify.h"
@@ -72,16 +73,6 @@ std::vector<const DeepSample*> layersOf(const DeepImage& image, size_t p, uint32
   return out;
 }
 
-StoredDepthFormat storedFormat(DepthFormat f) {
-  switch (f) {
-    case DepthFormat::FloatReversed: return StoredDepthFormat::FloatReversed;
-    case DepthFormat::Float: return StoredDepthFormat::Float;
-    case DepthFormat::Unorm24: return StoredDepthFormat::Unorm24;
-    case DepthFormat::Unorm16: return StoredDepthFormat::Unorm16;
-  }
-  return StoredDepthFormat::FloatReversed;
-}
-
 }  // namespace
 
 std::string explainPixel(const Scene& scene, const RenderSettings& settings, int x, int y) {
@@ -115,7 +106,7 @@ std::string explainPixel(const Scene& scene, const RenderSettings& settings, int
 
   // Hits side by side, with the mismatch class of each disagreement.
   ClassifierSettings cs;
-  cs.depthFormat = storedFormat(s.raster.depthFormat);
+  cs.depthFormat = storedDepthFormat(s.raster.depthFormat);
   cs.planes = {true, raster.camera.projection, raster.camera.znear, raster.camera.zfar};
   cs.scene = &scene;
   cs.camera = &raster.camera;

@@ -178,6 +178,13 @@ class Checker {
   const json& doc_;
 };
 
+// Checks that [offset, offset + size) lies inside [0, limit).
+bool fits(int64_t offset, int64_t size, int64_t limit) {
+  return offset >= 0 && size >= 0 && offset <= limit && size <= limit - offset;
+}
+
+}  // namespace
+
 int64_t componentSize(int64_t componentType) {
   switch (componentType) {
     case 5120: case 5121: return 1;
@@ -197,13 +204,6 @@ int64_t componentCount(const std::string& type) {
   if (type == "MAT4") return 16;
   return 0;
 }
-
-// Checks that [offset, offset + size) lies inside [0, limit).
-bool fits(int64_t offset, int64_t size, int64_t limit) {
-  return offset >= 0 && size >= 0 && offset <= limit && size <= limit - offset;
-}
-
-}  // namespace
 
 bool isSupportedExtension(const std::string& name) {
   for (const char* s : kSupportedExtensions)

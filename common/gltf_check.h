@@ -25,6 +25,11 @@ struct GltfCheckContext {
 // Throws InputError(file, element, message) on the first problem.
 void checkGltfDocument(const nlohmann::json& doc, const GltfCheckContext& context);
 
+// Bytes per component of a glTF componentType (0: not a glTF type), and
+// components per element of an accessor type (0: not a glTF type).
+int64_t componentSize(int64_t componentType);
+int64_t componentCount(const std::string& type);
+
 // Extensions rastray implements; any other name in extensionsRequired is
 // an error, names in extensionsUsed only are ignored.
 bool isSupportedExtension(const std::string& name);

@@ -240,23 +240,9 @@ double readComponent(const uint8_t* p, int64_t componentType, bool normalized) {
   }
 }
 
-size_t componentBytes(int64_t componentType) {
-  switch (componentType) {
-    case 5120: case 5121: return 1;
-    case 5122: case 5123: return 2;
-    default: return 4;
-  }
-}
-
-size_t typeComponents(const std::string& type) {
-  if (type == "SCALAR") return 1;
-  if (type == "VEC2") return 2;
-  if (type == "VEC3") return 3;
-  if (type == "VEC4") return 4;
-  if (type == "MAT2") return 4;
-  if (type == "MAT3") return 9;
-  return 16;
-}
+// Types and component types were checked (gltf_check), so both are > 0.
+size_t componentBytes(int64_t componentType) { return size_t(componentSize(componentType)); }
+size_t typeComponents(const std::string& type) { return size_t(componentCount(type)); }
 
 std::vector<double> SceneBuilder::readAccessor(int64_t index, const std::string& element,
                                                std::initializer_list<const char*> types,
