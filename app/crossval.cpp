@@ -39,10 +39,14 @@ uint32_t sampleCount(const DeepImage& image) {
 
 StoredDepthFormat storedDepthFormat(DepthFormat f) {
   switch (f) {
-    case DepthFormat::FloatReversed: return StoredDepthFormat::FloatReversed;
-    case DepthFormat::Float: return StoredDepthFormat::Float;
-    case DepthFormat::Unorm24: return StoredDepthFormat::Unorm24;
-    case DepthFormat::Unorm16: return StoredDepthFormat::Unorm16;
+    case DepthFormat::FloatReversed:
+      return StoredDepthFormat::FloatReversed;
+    case DepthFormat::Float:
+      return StoredDepthFormat::Float;
+    case DepthFormat::Unorm24:
+      return StoredDepthFormat::Unorm24;
+    case DepthFormat::Unorm16:
+      return StoredDepthFormat::Unorm16;
   }
   return StoredDepthFormat::FloatReversed;
 }
@@ -108,10 +112,10 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
   classifier.scene = &scene;
   classifier.camera = &r.camera;
   const FrameNames rasterNames{"raster", "raytrace"}, hybridNames{"hybrid", "raytrace"};
-  r.rasterVsRay = compareVisibility(r.raster.output.samples, r.raytrace.output.samples, settings.spp, classifier,
-                                    rasterNames);
-  r.hybridVsRay = compareVisibility(r.hybrid.output.samples, r.raytrace.output.samples, settings.spp, classifier,
-                                    hybridNames);
+  r.rasterVsRay = compareVisibility(r.raster.output.samples, r.raytrace.output.samples, settings.spp,
+                                    classifier, rasterNames);
+  r.hybridVsRay = compareVisibility(r.hybrid.output.samples, r.raytrace.output.samples, settings.spp,
+                                    classifier, hybridNames);
   r.rasterVsRayColor = compareColors(r.raster.output.image, r.raytrace.output.image);
   r.hybridVsRayColor = compareColors(r.hybrid.output.image, r.raytrace.output.image);
   r.hybridWhereAgree = colorWhereHitsAgree(r.hybrid.output.samples, r.raytrace.output.samples);

@@ -9,16 +9,16 @@
 #include <iostream>
 #include <memory>
 
-#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
+#include <nlohmann/json.hpp>
 
 #include "app/commands.h"
 #include "app/crossval.h"
 #include "app/crossval_report.h"
 #include "app/explain.h"
-#include "common/image.h"
 #include "app/render_setup.h"
 #include "common/error.h"
+#include "common/image.h"
 
 namespace rastray {
 
@@ -39,10 +39,13 @@ nlohmann::json visibilityJson(const VisibilityReport& v) {
   j["samples"] = {{"compared", v.samples.compared}, {"agreeing", v.samples.agreeing}};
   j["layers"] = {{"compared", v.layers.compared}, {"agreeing", v.layers.agreeing}};
   nlohmann::json classes = nlohmann::json::object();
-  for (int c = 0; c < kMismatchClassCount; ++c) classes[toString(MismatchClass(c))] = v.layers.count(MismatchClass(c));
+  for (int c = 0; c < kMismatchClassCount; ++c)
+    classes[toString(MismatchClass(c))] = v.layers.count(MismatchClass(c));
   j["mismatches"] = classes;
-  j["depthError"] = {{"meanAbsolute", v.depth.meanAbsolute}, {"maxAbsolute", v.depth.maxAbsolute},
-                     {"meanRelative", v.depth.meanRelative}, {"maxRelative", v.depth.maxRelative}};
+  j["depthError"] = {{"meanAbsolute", v.depth.meanAbsolute},
+                     {"maxAbsolute", v.depth.maxAbsolute},
+                     {"meanRelative", v.depth.meanRelative},
+                     {"maxRelative", v.depth.maxRelative}};
   return j;
 }
 
@@ -99,14 +102,14 @@ int runCrossval(CrossvalOptions& opt) {
     std::vector<std::vector<ReportExplanation>> explanations(results.size());
     for (size_t i = 0; i < results.size(); ++i) {
       const CrossvalResult& r = results[i];
-      const std::string folder =
-          opt.reportDir + "/" + std::filesystem::path(r.scenePath).stem().string();
+      const std::string folder = opt.reportDir + "/" + std::filesystem::path(r.scenePath).stem().string();
       std::filesystem::create_directories(folder);
       const Scene scene = loadScene(r.scenePath);
       for (int c = 0; c < kMismatchClassCount; ++c) {
         const auto& example = r.rasterVsRay.examples[size_t(c)];
         if (!example) continue;
-        if (terminal) std::fprintf(stderr, "\rexplaining %s: %-20s", r.scenePath.c_str(), toString(MismatchClass(c)));
+        if (terminal)
+          std::fprintf(stderr, "\rexplaining %s: %-20s", r.scenePath.c_str(), toString(MismatchClass(c)));
         const std::string file = std::string("explain-") + toString(MismatchClass(c)) + ".txt";
         writeTextFile(folder + "/" + file, explainPixel(scene, opt.settings, example->x, example->y));
         explanations[i].push_back({toString(MismatchClass(c)), file});
@@ -119,38 +122,42 @@ int runCrossval(CrossvalOptions& opt) {
   if (opt.json) {
     nlohmann::json j = nlohmann::json::array();
     for (const CrossvalResult& r : results)
-      j.push_back({{"scene", r.scenePath},
-                   {"width", r.camera.width},
-                   {"height", r.camera.height},
-                   {"spp", opt.settings.spp},
-                   {"rasterVsRaytrace", {{"visibility", visibilityJson(r.rasterVsRay)},
-                                         {"color", colorJson(r.rasterVsRayColor, r.rasterWhereAgree)}}},
-                   {"hybridVsRaytrace", {{"visibility", visibilityJson(r.hybridVsRay)},
-                                         {"color", colorJson(r.hybridVsRayColor, r.hybridWhereAgree)}}},
-                   {"seconds", {{"raster", r.raster.seconds}, {"raytrace", r.raytrace.seconds},
-                                {"hybrid", r.hybrid.seconds}}}});
+      j.push_back(
+          {{"scene", r.scenePath},
+           {"width", r.camera.width},
+           {"height", r.camera.height},
+           {"spp", opt.settings.spp},
+           {"rasterVsRaytrace",
+            {{"visibility", visibilityJson(r.rasterVsRay)},
+             {"color", colorJson(r.rasterVsRayColor, r.rasterWhereAgree)}}},
+           {"hybridVsRaytrace",
+            {{"visibility", visibilityJson(r.hybridVsRay)},
+             {"color", colorJson(r.hybridVsRayColor, r.hybridWhereAgree)}}},
+           {"seconds",
+            {{"raster", r.raster.seconds}, {"raytrace", r.raytrace.seconds}, {"hybrid", r.hybrid.seconds}}}});
     std::cout << nlohmann::json{{"scenes", j}, {"failures", failures}}.dump(2) << "\n";
   } else {
-    std::printf("%-22s %9s %4s %9s %9s %9s %7s %7s %7s %7s %7s %9s %8s %7s %9s %8s %8s %8s\n", "scene", "size", "spp",
-                "samples", "layers", "agree%", "edge", "shared", "ztie", "plane", "genuine", "max relZ", "RMS",
-                "PSNR", "hybrid d", "raster s", "ray s", "hybrid s");
+    std::printf("%-22s %9s %4s %9s %9s %9s %7s %7s %7s %7s %7s %9s %8s %7s %9s %8s %8s %8s\n", "scene",
+                "size", "spp", "samples", "layers", "agree%", "edge", "shared", "ztie", "plane", "genuine",
+                "max relZ", "RMS", "PSNR", "hybrid d", "raster s", "ray s", "hybrid s");
     for (const CrossvalResult& r : results) {
       const VisibilityReport& v = r.rasterVsRay;
       char size[32];
       std::snprintf(size, sizeof size, "%dx%d", r.camera.width, r.camera.height);
-      std::printf("%-22s %9s %4d %9llu %9llu %9.4f %7llu %7llu %7llu %7llu %7llu %9.2e %8.2e %7.1f %9.2e %8.3f %8.3f %8.3f\n",
-                  std::filesystem::path(r.scenePath).filename().string().c_str(), size, opt.settings.spp,
-                  (unsigned long long)v.samples.compared, (unsigned long long)v.layers.compared,
-                  100.0 * v.layers.agreement(),
-                  (unsigned long long)v.layers.count(MismatchClass::SilhouetteEdge),
-                  (unsigned long long)v.layers.count(MismatchClass::SharedEdgeTie),
-                  (unsigned long long)v.layers.count(MismatchClass::DepthTie),
-                  (unsigned long long)v.layers.count(MismatchClass::NearFarPlane),
-                  (unsigned long long)(v.layers.count(MismatchClass::Genuine) +
-                                       r.hybridVsRay.layers.count(MismatchClass::Genuine)),
-                  v.depth.maxRelative, r.rasterVsRayColor.rmsError,
-                  std::isinf(r.rasterVsRayColor.psnr) ? 999.9 : r.rasterVsRayColor.psnr, r.hybridWhereAgree.maxError,
-                  r.raster.seconds, r.raytrace.seconds, r.hybrid.seconds);
+      std::printf(
+          "%-22s %9s %4d %9llu %9llu %9.4f %7llu %7llu %7llu %7llu %7llu %9.2e %8.2e %7.1f %9.2e %8.3f %8.3f "
+          "%8.3f\n",
+          std::filesystem::path(r.scenePath).filename().string().c_str(), size, opt.settings.spp,
+          (unsigned long long)v.samples.compared, (unsigned long long)v.layers.compared,
+          100.0 * v.layers.agreement(), (unsigned long long)v.layers.count(MismatchClass::SilhouetteEdge),
+          (unsigned long long)v.layers.count(MismatchClass::SharedEdgeTie),
+          (unsigned long long)v.layers.count(MismatchClass::DepthTie),
+          (unsigned long long)v.layers.count(MismatchClass::NearFarPlane),
+          (unsigned long long)(v.layers.count(MismatchClass::Genuine) +
+                               r.hybridVsRay.layers.count(MismatchClass::Genuine)),
+          v.depth.maxRelative, r.rasterVsRayColor.rmsError,
+          std::isinf(r.rasterVsRayColor.psnr) ? 999.9 : r.rasterVsRayColor.psnr, r.hybridWhereAgree.maxError,
+          r.raster.seconds, r.raytrace.seconds, r.hybrid.seconds);
     }
     if (!opt.reportDir.empty()) std::printf("\nreport: %s/index.html\n", opt.reportDir.c_str());
     for (const std::string& f : failures) std::printf("FAIL %s\n", f.c_str());
@@ -163,13 +170,17 @@ int runCrossval(CrossvalOptions& opt) {
 CommandRunner addCrossvalCommand(CLI::App& app) {
   auto opt = std::make_shared<CrossvalOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "crossval", "Render scenes with the rasterizer, the ray caster and hybrid, and compare every sample and layer");
+      "crossval",
+      "Render scenes with the rasterizer, the ray caster and hybrid, and compare every sample and layer");
   cmd->add_option("scenes", opt->scenes, "glTF 2.0 files")->required();
-  cmd->add_option("--report", opt->reportDir, "Write an HTML report (index.html and images) into this folder");
+  cmd->add_option("--report", opt->reportDir,
+                  "Write an HTML report (index.html and images) into this folder");
   cmd->add_flag("--json", opt->json, "Print the results as JSON");
-  cmd->add_option("--min-agreement", opt->minAgreement, "Fail (exit 1) below this fraction of agreeing layers")
+  cmd->add_option("--min-agreement", opt->minAgreement,
+                  "Fail (exit 1) below this fraction of agreeing layers")
       ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--max-genuine", opt->maxGenuine, "Fail (exit 1) above this many genuine mismatches per scene")
+  cmd->add_option("--max-genuine", opt->maxGenuine,
+                  "Fail (exit 1) above this many genuine mismatches per scene")
       ->capture_default_str();
   cmd->add_option("--max-hybrid-error", opt->maxHybridError,
                   "Fail (exit 1) when hybrid and ray-cast colours differ by more where their hits agree")

@@ -16,11 +16,20 @@ std::string escapeHtml(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -65,9 +74,9 @@ std::string figure(const std::string& src, const std::string& caption, int width
 }
 
 std::string colorBarHtml(const ColorBar& bar) {
-  return "<div class=\"bar\" style=\"background:" + bar.cssGradient() + "\"></div><div class=\"barlabels\"><span>" +
-         fmt("%.3g", bar.lo) + "</span><span>" + escapeHtml(bar.quantity) + "</span><span>" + fmt("%.3g", bar.hi) +
-         "</span></div>";
+  return "<div class=\"bar\" style=\"background:" + bar.cssGradient() +
+         "\"></div><div class=\"barlabels\"><span>" + fmt("%.3g", bar.lo) + "</span><span>" +
+         escapeHtml(bar.quantity) + "</span><span>" + fmt("%.3g", bar.hi) + "</span></div>";
 }
 
 std::string legendHtml() {
@@ -84,13 +93,15 @@ std::string countersTable(const CrossvalResult& r) {
   for (const RenderRun* run : {&r.raster, &r.raytrace, &r.hybrid})
     for (const auto& [name, value] : run->output.counters.values)
       if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
-  std::string s = "<table><tr><th class=\"l\">counter</th><th>raster</th><th>raytrace</th><th>hybrid</th></tr>";
+  std::string s =
+      "<table><tr><th class=\"l\">counter</th><th>raster</th><th>raytrace</th><th>hybrid</th></tr>";
   for (const std::string& name : names) {
     s += "<tr><td class=\"l\">" + escapeHtml(name) + "</td>";
     for (const RenderRun* run : {&r.raster, &r.raytrace, &r.hybrid}) {
       bool present = false;
       for (const auto& [n, v] : run->output.counters.values) present |= n == name;
-      s += "<td>" + (present ? std::to_string(run->output.counters.get(name)) : std::string("&ndash;")) + "</td>";
+      s += "<td>" + (present ? std::to_string(run->output.counters.get(name)) : std::string("&ndash;")) +
+           "</td>";
     }
     s += "</tr>";
   }
@@ -127,23 +138,27 @@ std::string visibilityTable(const VisibilityReport& v, const char* a, const char
 }
 
 std::string colorTable(const ColorMetrics& m, const AgreeingColorStats& agree, const char* a, const char* b) {
-  std::string s = "<table><tr><th class=\"l\">" + std::string(a) + " vs " + b + " colour</th><th>value</th></tr>";
+  std::string s =
+      "<table><tr><th class=\"l\">" + std::string(a) + " vs " + b + " colour</th><th>value</th></tr>";
   auto row = [&](const std::string& k, const std::string& v) {
     s += "<tr><td class=\"l\">" + k + "</td><td>" + v + "</td></tr>";
   };
   row("mean |error|", fmt("%.3g", m.meanError));
   row("RMS error", fmt("%.3g", m.rmsError));
   row("PSNR", std::isinf(m.psnr) ? "&infin;" : fmt("%.2f dB", m.psnr));
-  row("max error", fmt("%.3g", m.maxError) + " at (" + std::to_string(m.maxX) + ", " + std::to_string(m.maxY) + ")");
+  row("max error",
+      fmt("%.3g", m.maxError) + " at (" + std::to_string(m.maxX) + ", " + std::to_string(m.maxY) + ")");
   row("pixels differing", std::to_string(m.differingPixels) + " of " + std::to_string(m.pixels));
   row("perceptibly different (Yee)", std::to_string(m.yeeFailingPixels));
-  row("max |error| where hits agree", fmt("%.3g", agree.maxError) + " over " + std::to_string(agree.layers) + " layers");
+  row("max |error| where hits agree",
+      fmt("%.3g", agree.maxError) + " over " + std::to_string(agree.layers) + " layers");
   return s + "</table>";
 }
 
 std::string sceneName(const CrossvalResult& r) { return std::filesystem::path(r.scenePath).stem().string(); }
 
-void writeScenePage(const std::string& dir, const CrossvalResult& r, const std::vector<ReportExplanation>& explain) {
+void writeScenePage(const std::string& dir, const CrossvalResult& r,
+                    const std::vector<ReportExplanation>& explain) {
   const int w = r.camera.width, h = r.camera.height;
   writePng(dir + "/raster.png", r.raster.output.image);
   writePng(dir + "/raytrace.png", r.raytrace.output.image);
@@ -151,21 +166,25 @@ void writeScenePage(const std::string& dir, const CrossvalResult& r, const std::
   writeMismatchMap(dir + "/mismatch.png", r.rasterVsRay);
   writeMismatchMap(dir + "/mismatch-hybrid.png", r.hybridVsRay);
   const ColorBar zBar = writeDepthDifferenceMap(dir + "/depth-diff.png", r.rasterVsRay);
-  const ColorBar cBar = writeDifferenceHeatMap(dir + "/color-diff.png", r.raster.output.image, r.raytrace.output.image);
+  const ColorBar cBar =
+      writeDifferenceHeatMap(dir + "/color-diff.png", r.raster.output.image, r.raytrace.output.image);
   const ColorBar hBar =
       writeDifferenceHeatMap(dir + "/color-diff-hybrid.png", r.hybrid.output.image, r.raytrace.output.image);
 
-  std::string b = "<p><a href=\"../index.html\">&larr; all scenes</a></p><h1>" + escapeHtml(r.scenePath) + "</h1>";
-  b += "<p>" + std::to_string(w) + "&times;" + std::to_string(h) + ", " + escapeHtml(r.camera.describe()) + "</p>";
+  std::string b =
+      "<p><a href=\"../index.html\">&larr; all scenes</a></p><h1>" + escapeHtml(r.scenePath) + "</h1>";
+  b += "<p>" + std::to_string(w) + "&times;" + std::to_string(h) + ", " + escapeHtml(r.camera.describe()) +
+       "</p>";
   b += "<h2>Renders</h2><div class=\"row\">" +
        figure("raster.png", "rasterizer (" + fmt("%.3f s", r.raster.seconds) + ")", w, h) +
        figure("raytrace.png", "ray caster (" + fmt("%.3f s", r.raytrace.seconds) + ")", w, h) +
-       figure("hybrid.png", "hybrid: rasterized visibility, traced rays (" + fmt("%.3f s", r.hybrid.seconds) + ")", w,
-              h) +
+       figure("hybrid.png",
+              "hybrid: rasterized visibility, traced rays (" + fmt("%.3f s", r.hybrid.seconds) + ")", w, h) +
        "</div>";
   b += "<h2>Where visibility differs</h2><div class=\"row\">" +
        figure("mismatch.png", "rasterizer vs ray caster, each pixel's most severe class", w, h) +
-       figure("mismatch-hybrid.png", "hybrid vs ray caster", w, h) + "<figure>" + legendHtml() + "</figure></div>";
+       figure("mismatch-hybrid.png", "hybrid vs ray caster", w, h) + "<figure>" + legendHtml() +
+       "</figure></div>";
   b += visibilityTable(r.rasterVsRay, "raster", "raytrace");
   b += visibilityTable(r.hybridVsRay, "hybrid", "raytrace");
   if (!explain.empty()) {
@@ -188,9 +207,10 @@ void writeScenePage(const std::string& dir, const CrossvalResult& r, const std::
   b += "<figure><img class=\"px\" src=\"color-diff.png\" width=\"" + std::to_string(w < 256 ? 256 : w) +
        "\" alt=\"colour difference\"><figcaption>raster vs ray caster, max |&Delta;| over RGBA</figcaption>" +
        colorBarHtml(cBar) + "</figure>";
-  b += "<figure><img class=\"px\" src=\"color-diff-hybrid.png\" width=\"" + std::to_string(w < 256 ? 256 : w) +
-       "\" alt=\"hybrid colour difference\"><figcaption>hybrid vs ray caster</figcaption>" + colorBarHtml(hBar) +
-       "</figure></div>";
+  b += "<figure><img class=\"px\" src=\"color-diff-hybrid.png\" width=\"" +
+       std::to_string(w < 256 ? 256 : w) +
+       "\" alt=\"hybrid colour difference\"><figcaption>hybrid vs ray caster</figcaption>" +
+       colorBarHtml(hBar) + "</figure></div>";
   b += colorTable(r.rasterVsRayColor, r.rasterWhereAgree, "raster", "raytrace");
   b += colorTable(r.hybridVsRayColor, r.hybridWhereAgree, "hybrid", "raytrace");
   b += "<h2>Work counters</h2>" + countersTable(r);
@@ -202,7 +222,8 @@ void writeScenePage(const std::string& dir, const CrossvalResult& r, const std::
                                   {"hybrid", &r.hybrid}}) {
     b += "<tr><td class=\"l\">" + std::string(name) + "</td><td>" + fmt("%.4f", run->seconds) + "</td></tr>";
     for (const auto& [stage, t] : run->output.timings)
-      b += "<tr><td class=\"l\">&nbsp;&nbsp;" + escapeHtml(stage) + "</td><td>" + fmt("%.4f", t) + "</td></tr>";
+      b += "<tr><td class=\"l\">&nbsp;&nbsp;" + escapeHtml(stage) + "</td><td>" + fmt("%.4f", t) +
+           "</td></tr>";
   }
   b += "</table>";
   writeTextFile(dir + "/index.html", page(sceneName(r) + " - rastray crossval", b));
@@ -217,13 +238,15 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError(dir, "", "cannot create the report folder: " + ec.message());
 
-  std::string b = "<h1>rastray cross-validation</h1><p>Each scene rendered by the rasterizer, the Embree ray caster "
-                  "and hybrid (rasterized visibility, traced secondary rays) with identical camera, samples and "
-                  "shading, then compared sample by sample and layer by layer.</p>";
-  b += "<p>" + std::to_string(settings.spp) + " spp, rasterizer depth format " + escapeHtml(settings.depthFormat) +
-       ", transparency " + escapeHtml(settings.transparency) + ".</p>";
+  std::string b =
+      "<h1>rastray cross-validation</h1><p>Each scene rendered by the rasterizer, the Embree ray caster "
+      "and hybrid (rasterized visibility, traced secondary rays) with identical camera, samples and "
+      "shading, then compared sample by sample and layer by layer.</p>";
+  b += "<p>" + std::to_string(settings.spp) + " spp, rasterizer depth format " +
+       escapeHtml(settings.depthFormat) + ", transparency " + escapeHtml(settings.transparency) + ".</p>";
   b += "<table><tr><th class=\"l\">scene</th><th>size</th><th>samples</th><th>layers</th><th>agree</th>";
-  for (int c = 0; c < kMismatchClassCount; ++c) b += "<th>" + std::string(displayName(MismatchClass(c))) + "</th>";
+  for (int c = 0; c < kMismatchClassCount; ++c)
+    b += "<th>" + std::string(displayName(MismatchClass(c))) + "</th>";
   b += "<th>max rel &Delta;Z</th><th>RMS</th><th>PSNR</th><th>hybrid &Delta; where hits agree</th>"
        "<th>raster s</th><th>raytrace s</th><th>hybrid s</th></tr>";
   for (size_t i = 0; i < results.size(); ++i) {
@@ -234,24 +257,28 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
     if (ec) throw InputError(sceneDir, "", "cannot create the folder: " + ec.message());
     writeScenePage(sceneDir, r, i < explanations.size() ? explanations[i] : std::vector<ReportExplanation>{});
     const VisibilityReport& v = r.rasterVsRay;
-    b += "<tr><td class=\"l\"><a href=\"" + escapeHtml(name) + "/index.html\">" + escapeHtml(name) + "</a></td><td>" +
-         std::to_string(r.camera.width) + "&times;" + std::to_string(r.camera.height) + "</td><td>" +
-         std::to_string(v.samples.compared) + "</td><td>" + std::to_string(v.layers.compared) + "</td><td>" +
-         percent(v.layers.agreement()) + "</td>";
+    b += "<tr><td class=\"l\"><a href=\"" + escapeHtml(name) + "/index.html\">" + escapeHtml(name) +
+         "</a></td><td>" + std::to_string(r.camera.width) + "&times;" + std::to_string(r.camera.height) +
+         "</td><td>" + std::to_string(v.samples.compared) + "</td><td>" + std::to_string(v.layers.compared) +
+         "</td><td>" + percent(v.layers.agreement()) + "</td>";
     for (int c = 0; c < kMismatchClassCount; ++c) {
       const uint64_t n = v.layers.count(MismatchClass(c));
       const bool bad = MismatchClass(c) == MismatchClass::Genuine && n > 0;
       b += std::string("<td") + (bad ? " class=\"bad\"" : "") + ">" + std::to_string(n) + "</td>";
     }
     b += "<td>" + fmt("%.3g", v.depth.maxRelative) + "</td><td>" + fmt("%.3g", r.rasterVsRayColor.rmsError) +
-         "</td><td>" + (std::isinf(r.rasterVsRayColor.psnr) ? "&infin;" : fmt("%.1f", r.rasterVsRayColor.psnr)) +
-         "</td><td>" + fmt("%.3g", r.hybridWhereAgree.maxError) + "</td><td>" + fmt("%.3f", r.raster.seconds) +
-         "</td><td>" + fmt("%.3f", r.raytrace.seconds) + "</td><td>" + fmt("%.3f", r.hybrid.seconds) + "</td></tr>";
+         "</td><td>" +
+         (std::isinf(r.rasterVsRayColor.psnr) ? "&infin;" : fmt("%.1f", r.rasterVsRayColor.psnr)) +
+         "</td><td>" + fmt("%.3g", r.hybridWhereAgree.maxError) + "</td><td>" +
+         fmt("%.3f", r.raster.seconds) + "</td><td>" + fmt("%.3f", r.raytrace.seconds) + "</td><td>" +
+         fmt("%.3f", r.hybrid.seconds) + "</td></tr>";
   }
   b += "</table><h2>Mismatch classes</h2>" + legendHtml();
-  b += "<p>Shared-edge tie: both renderers hit triangles of one instance that share an edge, at a sample within "
+  b += "<p>Shared-edge tie: both renderers hit triangles of one instance that share an edge, at a sample "
+       "within "
        "the edge distance of it (SPEC 3 lets either win). Depth tie: |&Delta;Z| within the depth format's "
-       "resolution (z-fighting). Near/far plane: a hit at or beyond a clipping plane. Silhouette edge: the sample "
+       "resolution (z-fighting). Near/far plane: a hit at or beyond a clipping plane. Silhouette edge: the "
+       "sample "
        "lies within the edge distance of an edge of either triangle. Genuine: none of these.</p>";
   writeTextFile(dir + "/index.html", page("rastray crossval", b));
 }

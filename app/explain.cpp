@@ -29,7 +29,8 @@ class StderrCapture {
  public:
   StderrCapture() {
     std::fflush(stderr);
-    path_ = (std::filesystem::temp_directory_path() / ("rastray-explain-" + std::to_string(getpid()))).string();
+    path_ =
+        (std::filesystem::temp_directory_path() / ("rastray-explain-" + std::to_string(getpid()))).string();
     saved_ = dup(STDERR_FILENO);
     std::FILE* f = std::fopen(path_.c_str(), "w");
     if (saved_ < 0 || !f) throw std::runtime_error("cannot capture the renderers' trace output");
@@ -100,8 +101,9 @@ std::string explainPixel(const Scene& scene, const RenderSettings& settings, int
     rayTrace = capture.finish();
   }
 
-  std::snprintf(line, sizeof line, "pixel (%d, %d) of %s, %dx%d, %d spp\ncamera %s\n\n", x, y, scene.path.c_str(),
-                raster.camera.width, raster.camera.height, s.spp, raster.camera.describe().c_str());
+  std::snprintf(line, sizeof line, "pixel (%d, %d) of %s, %dx%d, %d spp\ncamera %s\n\n", x, y,
+                scene.path.c_str(), raster.camera.width, raster.camera.height, s.spp,
+                raster.camera.describe().c_str());
   out += line;
 
   // Hits side by side, with the mismatch class of each disagreement.
@@ -127,8 +129,8 @@ std::string explainPixel(const Scene& scene, const RenderSettings& settings, int
       if (lb) hb = {lb->instance, lb->triangle, lb->depth};
       std::string verdict = "agree";
       if (!ha.sameSurface(hb)) verdict = displayName(classifier.classify(pos, ha, hb, ImageSpaceEvidence{}));
-      std::snprintf(line, sizeof line, "  layer %zu: raster %-34s raytrace %-34s %s\n", k, hitText(la).c_str(),
-                    hitText(lb).c_str(), verdict.c_str());
+      std::snprintf(line, sizeof line, "  layer %zu: raster %-34s raytrace %-34s %s\n", k,
+                    hitText(la).c_str(), hitText(lb).c_str(), verdict.c_str());
       out += line;
       if (!ha.sameSurface(hb)) {
         if (ha.isHit()) {
@@ -161,8 +163,9 @@ int runExplain(ExplainOptions& opt) {
   opt.settings.finish();
   const Scene scene = loadScene(opt.scenePath);
   if (opt.x < 0 || opt.y < 0 || opt.x >= opt.settings.camera.width() || opt.y >= opt.settings.camera.height())
-    throw InputError("command line", "X Y", "pixel (" + std::to_string(opt.x) + ", " + std::to_string(opt.y) +
-                                                ") lies outside the image");
+    throw InputError(
+        "command line", "X Y",
+        "pixel (" + std::to_string(opt.x) + ", " + std::to_string(opt.y) + ") lies outside the image");
   std::fputs(explainPixel(scene, opt.settings, opt.x, opt.y).c_str(), stdout);
   return 0;
 }
@@ -172,7 +175,8 @@ int runExplain(ExplainOptions& opt) {
 CommandRunner addExplainCommand(CLI::App& app) {
   auto opt = std::make_shared<ExplainOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "explain", "Show every sample of one pixel as the rasterizer and the ray caster saw it, and why they differ");
+      "explain",
+      "Show every sample of one pixel as the rasterizer and the ray caster saw it, and why they differ");
   cmd->add_option("scene", opt->scenePath, "glTF 2.0 file")->required();
   cmd->add_option("x", opt->x, "Pixel column (0 = left)")->required();
   cmd->add_option("y", opt->y, "Pixel row (0 = top)")->required();

@@ -72,12 +72,20 @@ int runInfo(const InfoOptions& opt) {
     j["degenerateTriangles"] = degenerate;
     j["vertices"] = scene.positions.size();
     j["skippedPrimitives"] = scene.stats.skippedPrimitives;
-    j["materials"] = {{"total", scene.materials.size()}, {"opaque", mc.opaque}, {"mask", mc.mask},
-                      {"blend", mc.blend}, {"reflective", mc.reflective}, {"refractive", mc.refractive},
-                      {"emissive", mc.emissive}, {"textured", mc.textured}, {"doubleSided", mc.doubleSided}};
+    j["materials"] = {{"total", scene.materials.size()},
+                      {"opaque", mc.opaque},
+                      {"mask", mc.mask},
+                      {"blend", mc.blend},
+                      {"reflective", mc.reflective},
+                      {"refractive", mc.refractive},
+                      {"emissive", mc.emissive},
+                      {"textured", mc.textured},
+                      {"doubleSided", mc.doubleSided}};
     j["textures"] = scene.textures.size();
     j["images"] = scene.images.size();
-    j["lights"] = {{"total", scene.lights.size()}, {"point", lightsByType[0]}, {"spot", lightsByType[1]},
+    j["lights"] = {{"total", scene.lights.size()},
+                   {"point", lightsByType[0]},
+                   {"spot", lightsByType[1]},
                    {"directional", lightsByType[2]}};
     j["cameras"] = scene.stats.cameras;
     j["cameraNodes"] = scene.stats.cameraNodes;
@@ -104,10 +112,17 @@ int runInfo(const InfoOptions& opt) {
     nlohmann::json inst = nlohmann::json::array();
     for (size_t i = 0; i < scene.instances.size(); ++i) {
       const Instance& in = scene.instances[i];
-      inst.push_back({{"instance", i}, {"node", in.node}, {"mesh", in.mesh}, {"primitive", in.primitive},
-                      {"mode", in.mode}, {"material", in.material}, {"triangles", in.triangleCount},
-                      {"vertices", in.vertexCount}, {"degenerate", in.degenerateCount},
-                      {"mirrored", in.mirrored}, {"normals", in.normals == NormalSource::Authored ? "authored" : "flat"}});
+      inst.push_back({{"instance", i},
+                      {"node", in.node},
+                      {"mesh", in.mesh},
+                      {"primitive", in.primitive},
+                      {"mode", in.mode},
+                      {"material", in.material},
+                      {"triangles", in.triangleCount},
+                      {"vertices", in.vertexCount},
+                      {"degenerate", in.degenerateCount},
+                      {"mirrored", in.mirrored},
+                      {"normals", in.normals == NormalSource::Authored ? "authored" : "flat"}});
     }
     j["instanceList"] = inst;
     std::cout << j.dump(2) << "\n";
@@ -115,18 +130,20 @@ int runInfo(const InfoOptions& opt) {
   }
 
   std::printf("scene      %s%s\n", scene.path.c_str(),
-              scene.stats.sceneIndex >= 0 ? (" (scene " + std::to_string(scene.stats.sceneIndex) + ")").c_str()
-                                          : " (no scenes: all root nodes)");
+              scene.stats.sceneIndex >= 0
+                  ? (" (scene " + std::to_string(scene.stats.sceneIndex) + ")").c_str()
+                  : " (no scenes: all root nodes)");
   std::printf("nodes      %u in file, %u visited; %u meshes\n", scene.stats.nodes, scene.stats.visitedNodes,
               scene.stats.meshes);
   std::printf("instances  %zu (%u point/line primitives skipped)\n", scene.instances.size(),
               scene.stats.skippedPrimitives);
   std::printf("triangles  %zu (%zu degenerate), %zu vertices\n", scene.triangles.size(), degenerate,
               scene.positions.size());
-  std::printf("materials  %zu: %d opaque, %d mask, %d blend; %d reflective, %d refractive, %d emissive, "
-              "%d textured, %d double-sided\n",
-              scene.materials.size(), mc.opaque, mc.mask, mc.blend, mc.reflective, mc.refractive, mc.emissive,
-              mc.textured, mc.doubleSided);
+  std::printf(
+      "materials  %zu: %d opaque, %d mask, %d blend; %d reflective, %d refractive, %d emissive, "
+      "%d textured, %d double-sided\n",
+      scene.materials.size(), mc.opaque, mc.mask, mc.blend, mc.reflective, mc.refractive, mc.emissive,
+      mc.textured, mc.doubleSided);
   std::printf("textures   %zu (%zu images)\n", scene.textures.size(), scene.images.size());
   std::printf("lights     %zu: %d point, %d spot, %d directional\n", scene.lights.size(), lightsByType[0],
               lightsByType[1], lightsByType[2]);

@@ -36,8 +36,9 @@ void printErrorLine(const std::string& message) {
 
 int main(int argc, char** argv) {
   using namespace rastray;
-  CLI::App app{"rastray: render one glTF scene with a z-buffer rasterizer and an Embree ray caster, "
-               "and compare them sample by sample"};
+  CLI::App app{
+      "rastray: render one glTF scene with a z-buffer rasterizer and an Embree ray caster, "
+      "and compare them sample by sample"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "rastray 0.1");
   std::vector<CommandRunner> commands;

@@ -4,8 +4,8 @@
 #include <iostream>
 #include <memory>
 
-#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
+#include <nlohmann/json.hpp>
 
 #include "app/cli_options.h"
 #include "app/commands.h"
@@ -72,7 +72,8 @@ int runRender(RenderCommandOptions& opt) {
 
 CommandRunner addRenderCommand(CLI::App& app) {
   auto opt = std::make_shared<RenderCommandOptions>();
-  CLI::App* cmd = app.add_subcommand("render", "Render a scene with the rasterizer, the ray caster or both (hybrid)");
+  CLI::App* cmd =
+      app.add_subcommand("render", "Render a scene with the rasterizer, the ray caster or both (hybrid)");
   cmd->add_option("scene", opt->scenePath, "glTF 2.0 file (.gltf or .glb)")->required();
   cmd->add_option("-o,--output", opt->output, "Output image: .png (sRGB) or .exr (linear, with Z and IDs)")
       ->required();

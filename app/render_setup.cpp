@@ -29,9 +29,12 @@ Enum pick(const std::string& option, const std::string& value,
 
 const char* toString(RendererKind kind) {
   switch (kind) {
-    case RendererKind::Raster: return "raster";
-    case RendererKind::Raytrace: return "raytrace";
-    case RendererKind::Hybrid: return "hybrid";
+    case RendererKind::Raster:
+      return "raster";
+    case RendererKind::Raytrace:
+      return "raytrace";
+    case RendererKind::Hybrid:
+      return "hybrid";
   }
   return "?";
 }
@@ -39,31 +42,37 @@ const char* toString(RendererKind kind) {
 void addRenderSettings(CLI::App& cmd, RenderSettings& s, bool withRenderer) {
   if (withRenderer)
     cmd.add_option("--renderer", s.rendererName,
-                   "raster, raytrace or hybrid (rasterized primary visibility, traced shadow/reflection/refraction rays)")
+                   "raster, raytrace or hybrid (rasterized primary visibility, traced "
+                   "shadow/reflection/refraction rays)")
         ->capture_default_str();
   cmd.add_option("--spp", s.spp, "Samples per pixel: " + supportedSampleCounts())->capture_default_str();
   s.camera.addTo(cmd);
   cmd.add_option("--threads", s.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
-  cmd.add_option("--debug-pixel", s.debugPixelXY, "Trace what each stage did at pixel X Y (stderr)")->expected(2);
-  cmd.add_option("--texture-filter", s.textureFilter, "sampler (as the file says), nearest, bilinear or trilinear")
+  cmd.add_option("--debug-pixel", s.debugPixelXY, "Trace what each stage did at pixel X Y (stderr)")
+      ->expected(2);
+  cmd.add_option("--texture-filter", s.textureFilter,
+                 "sampler (as the file says), nearest, bilinear or trilinear")
       ->capture_default_str();
   cmd.add_option("--max-depth", s.shading.maxDepth, "Deepest secondary ray (reflection/refraction)")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
   // Rasterizer.
   cmd.add_option("--cull", s.cull, "Cull single-sided triangles: back, front or none")->capture_default_str();
-  cmd.add_option("--depth-format", s.depthFormat, "float-reversed, float, unorm24 or unorm16")->capture_default_str();
+  cmd.add_option("--depth-format", s.depthFormat, "float-reversed, float, unorm24 or unorm16")
+      ->capture_default_str();
   cmd.add_option("--depth-func", s.depthFunc, "less or lequal")->capture_default_str();
   cmd.add_option("--polygon-offset", s.polygonOffset, "FACTOR UNITS, as glPolygonOffset")->expected(2);
   cmd.add_option("--transparency", s.transparency, "sorted, peel:N or exact (per-sample fragment lists)")
       ->capture_default_str();
-  cmd.add_option("--shadows", s.shadows, "map (shadow maps), rays (hybrid) or none; default map, rays for hybrid");
+  cmd.add_option("--shadows", s.shadows,
+                 "map (shadow maps), rays (hybrid) or none; default map, rays for hybrid");
   cmd.add_option("--shadow-map-size", s.raster.shadowMapSize, "Shadow map resolution")
       ->check(CLI::Range(16, 16384))
       ->capture_default_str();
   cmd.add_option("--shadow-bias", s.shadowBias, "CONSTANT SLOPE shadow-map depth bias")->expected(2);
-  cmd.add_option("--shading-rate", s.shadingRate, "sample (shade every sample) or pixel (once per pixel and "
-                                                  "triangle, as MSAA)")
+  cmd.add_option("--shading-rate", s.shadingRate,
+                 "sample (shade every sample) or pixel (once per pixel and "
+                 "triangle, as MSAA)")
       ->capture_default_str();
   cmd.add_flag("--wireframe", s.raster.wireframe, "Draw visible triangle edges over the image");
   cmd.add_flag("--halo", s.raster.halo, "With --wireframe: gap each edge where a nearer edge crosses it");
@@ -72,7 +81,8 @@ void addRenderSettings(CLI::App& cmd, RenderSettings& s, bool withRenderer) {
                  "Stop compositing along a ray once the remaining transmittance is below this")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd.add_flag("!--no-packets", s.ray.packets, "Trace primary rays one by one instead of in coherent packets");
+  cmd.add_flag("!--no-packets", s.ray.packets,
+               "Trace primary rays one by one instead of in coherent packets");
 }
 
 void RenderSettings::finish() {
@@ -90,14 +100,15 @@ void RenderSettings::finish() {
   if (!debugPixelXY.empty()) debugPixel = glm::ivec2(debugPixelXY[0], debugPixelXY[1]);
 
   raster.spp = spp;
-  raster.cull = pick<CullMode>("--cull", cull, {{"none", CullMode::None}, {"back", CullMode::Back},
-                                                {"front", CullMode::Front}});
+  raster.cull = pick<CullMode>(
+      "--cull", cull, {{"none", CullMode::None}, {"back", CullMode::Back}, {"front", CullMode::Front}});
   raster.depthFormat = pick<DepthFormat>("--depth-format", depthFormat,
                                          {{"float-reversed", DepthFormat::FloatReversed},
                                           {"float", DepthFormat::Float},
                                           {"unorm24", DepthFormat::Unorm24},
                                           {"unorm16", DepthFormat::Unorm16}});
-  raster.depthFunc = pick<DepthFunc>("--depth-func", depthFunc, {{"less", DepthFunc::Less}, {"lequal", DepthFunc::LEqual}});
+  raster.depthFunc =
+      pick<DepthFunc>("--depth-func", depthFunc, {{"less", DepthFunc::Less}, {"lequal", DepthFunc::LEqual}});
   if (!polygonOffset.empty()) {
     raster.polygonOffsetFactor = polygonOffset[0];
     raster.polygonOffsetUnits = polygonOffset[1];
@@ -120,9 +131,11 @@ void RenderSettings::finish() {
   } else {
     badOption("--transparency", "'" + transparency + "' is not one of sorted, peel:N, exact");
   }
-  const std::string shadowName = shadows.empty() ? (renderer == RendererKind::Hybrid ? "rays" : "map") : shadows;
-  raster.shadows = pick<ShadowMode>("--shadows", shadowName,
-                                    {{"map", ShadowMode::Map}, {"rays", ShadowMode::Rays}, {"none", ShadowMode::None}});
+  const std::string shadowName =
+      shadows.empty() ? (renderer == RendererKind::Hybrid ? "rays" : "map") : shadows;
+  raster.shadows =
+      pick<ShadowMode>("--shadows", shadowName,
+                       {{"map", ShadowMode::Map}, {"rays", ShadowMode::Rays}, {"none", ShadowMode::None}});
   if (raster.shadows == ShadowMode::Rays && renderer == RendererKind::Raster)
     badOption("--shadows", "'rays' needs --renderer hybrid or raytrace");
   if (renderer == RendererKind::Raytrace && raster.shadows == ShadowMode::Map && !shadows.empty())

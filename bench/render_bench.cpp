@@ -47,7 +47,8 @@ void rasterFrame(benchmark::State& state, const std::string& name) {
   RasterOptions o;
   o.spp = kSpp;
   for (auto _ : state) benchmark::DoNotOptimize(renderRaster(l.scene, l.analysis, l.camera, o));
-  state.SetLabel(std::to_string(kWidth) + "x" + std::to_string(kHeight) + " " + std::to_string(kSpp) + " spp");
+  state.SetLabel(std::to_string(kWidth) + "x" + std::to_string(kHeight) + " " + std::to_string(kSpp) +
+                 " spp");
 }
 
 void raytraceFrame(benchmark::State& state, const std::string& name) {
@@ -59,7 +60,8 @@ void raytraceFrame(benchmark::State& state, const std::string& name) {
     caster.bind(l.camera, o);
     benchmark::DoNotOptimize(caster.render());
   }
-  state.SetLabel(std::to_string(kWidth) + "x" + std::to_string(kHeight) + " " + std::to_string(kSpp) + " spp");
+  state.SetLabel(std::to_string(kWidth) + "x" + std::to_string(kHeight) + " " + std::to_string(kSpp) +
+                 " spp");
 }
 
 void hybridFrame(benchmark::State& state, const std::string& name) {
@@ -74,7 +76,8 @@ void hybridFrame(benchmark::State& state, const std::string& name) {
     caster.bind(l.camera, yo);
     benchmark::DoNotOptimize(renderRaster(l.scene, l.analysis, l.camera, ro, &caster, &caster));
   }
-  state.SetLabel(std::to_string(kWidth) + "x" + std::to_string(kHeight) + " " + std::to_string(kSpp) + " spp");
+  state.SetLabel(std::to_string(kWidth) + "x" + std::to_string(kHeight) + " " + std::to_string(kSpp) +
+                 " spp");
 }
 
 void registerAll() {

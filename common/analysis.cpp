@@ -6,12 +6,18 @@ namespace rastray {
 
 const char* toString(Work work) {
   switch (work) {
-    case Work::TransparencyPass: return "transparency pass";
-    case Work::AlphaTest: return "alpha test";
-    case Work::Shadows: return "shadows";
-    case Work::ReflectionRays: return "reflection rays";
-    case Work::RefractionRays: return "refraction rays";
-    case Work::Textures: return "textures";
+    case Work::TransparencyPass:
+      return "transparency pass";
+    case Work::AlphaTest:
+      return "alpha test";
+    case Work::Shadows:
+      return "shadows";
+    case Work::ReflectionRays:
+      return "reflection rays";
+    case Work::RefractionRays:
+      return "refraction rays";
+    case Work::Textures:
+      return "textures";
   }
   return "?";
 }
@@ -39,8 +45,8 @@ WorkDecision decide(const Scene& scene, Work work, const std::string& what, Pred
   WorkDecision d{work, !materials.empty(), {}};
   if (d.needed)
     d.reason = std::to_string(materials.size()) + " " + what + " material" +
-               (materials.size() == 1 ? "" : "s") + " on " + std::to_string(instances) +
-               " instance" + (instances == 1 ? "" : "s");
+               (materials.size() == 1 ? "" : "s") + " on " + std::to_string(instances) + " instance" +
+               (instances == 1 ? "" : "s");
   else
     d.reason = "no " + what + " material";
   return d;
@@ -56,18 +62,17 @@ SceneAnalysis analyzeScene(const Scene& scene) {
                                [](const Material& m) { return m.alphaMode == AlphaMode::Mask; }));
 
   WorkDecision shadows{Work::Shadows, !scene.lights.empty(), {}};
-  shadows.reason = shadows.needed
-                       ? std::to_string(scene.lights.size()) + " punctual light" +
-                             (scene.lights.size() == 1 ? "" : "s")
-                       : "no light: eye light at the camera, no shadows";
+  shadows.reason = shadows.needed ? std::to_string(scene.lights.size()) + " punctual light" +
+                                        (scene.lights.size() == 1 ? "" : "s")
+                                  : "no light: eye light at the camera, no shadows";
   a.decisions.push_back(shadows);
 
-  a.decisions.push_back(decide(scene, Work::ReflectionRays, "reflective",
-                               [](const Material& m) { return m.isReflective(); }));
-  a.decisions.push_back(decide(scene, Work::RefractionRays, "refractive",
-                               [](const Material& m) { return m.isRefractive(); }));
-  a.decisions.push_back(decide(scene, Work::Textures, "textured",
-                               [](const Material& m) { return m.baseColorTexture >= 0; }));
+  a.decisions.push_back(
+      decide(scene, Work::ReflectionRays, "reflective", [](const Material& m) { return m.isReflective(); }));
+  a.decisions.push_back(
+      decide(scene, Work::RefractionRays, "refractive", [](const Material& m) { return m.isRefractive(); }));
+  a.decisions.push_back(
+      decide(scene, Work::Textures, "textured", [](const Material& m) { return m.baseColorTexture >= 0; }));
 
   a.transparency = a.needs(Work::TransparencyPass);
   a.alphaTest = a.needs(Work::AlphaTest);

@@ -35,7 +35,7 @@ struct SceneAnalysis {
   bool reflection = false;
   bool refraction = false;
   bool textures = false;
-  bool eyeLight = false;  // no light in the scene: lit from the camera, no shadows
+  bool eyeLight = false;                // no light in the scene: lit from the camera, no shadows
   std::vector<WorkDecision> decisions;  // one per Work, in enum order
 
   bool secondaryRays() const { return reflection || refraction; }

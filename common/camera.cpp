@@ -25,9 +25,7 @@ std::string fmt(const glm::dvec3& v) {
   return buf;
 }
 
-bool finite(const glm::dvec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 }  // namespace
 
@@ -87,16 +85,15 @@ std::string Camera::describe() const {
     std::snprintf(buf, sizeof buf, "perspective yfov %.4g deg aspect %.4g znear %.6g zfar %.6g",
                   yfov * 180.0 / kPi, aspect, znear, zfar);
   else
-    std::snprintf(buf, sizeof buf, "orthographic xmag %.6g ymag %.6g znear %.6g zfar %.6g", xmag,
-                  ymag, znear, zfar);
-  return std::string(buf) + " eye " + fmt(eye()) + " forward " + fmt(forward()) + " [" + origin +
-         "]";
+    std::snprintf(buf, sizeof buf, "orthographic xmag %.6g ymag %.6g znear %.6g zfar %.6g", xmag, ymag, znear,
+                  zfar);
+  return std::string(buf) + " eye " + fmt(eye()) + " forward " + fmt(forward()) + " [" + origin + "]";
 }
 
 Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int width, int height) {
   if (width < 1 || height < 1)
-    badOption("--size", "image size " + std::to_string(width) + "x" + std::to_string(height) +
-                            " must be at least 1x1");
+    badOption("--size",
+              "image size " + std::to_string(width) + "x" + std::to_string(height) + " must be at least 1x1");
   const CameraModel model = scene.camera ? *scene.camera : defaultCameraModel(scene);
 
   Camera camera;
@@ -148,13 +145,12 @@ Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int widt
     right = glm::normalize(glm::cross(forward, up));
     up = glm::cross(right, forward);
   }
-  camera.worldFromView = glm::dmat4(glm::dvec4(right, 0.0), glm::dvec4(up, 0.0),
-                                    glm::dvec4(-forward, 0.0), glm::dvec4(eye, 1.0));
+  camera.worldFromView = glm::dmat4(glm::dvec4(right, 0.0), glm::dvec4(up, 0.0), glm::dvec4(-forward, 0.0),
+                                    glm::dvec4(eye, 1.0));
   camera.viewFromWorld = glm::inverse(camera.worldFromView);
 
   if (overrides.yfovDegrees) {
-    if (camera.projection != Projection::Perspective)
-      badOption("--yfov", "the camera is orthographic");
+    if (camera.projection != Projection::Perspective) badOption("--yfov", "the camera is orthographic");
     const double deg = *overrides.yfovDegrees;
     if (!(deg > 0.0 && deg < 180.0)) badOption("--yfov", "must lie in (0, 180) degrees");
     camera.yfov = deg * kPi / 180.0;
@@ -170,11 +166,9 @@ Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int widt
   }
   if (camera.projection == Projection::Perspective && !(camera.znear > 0.0 && std::isfinite(camera.znear)))
     badOption("--znear", "znear " + std::to_string(camera.znear) + " must be finite and > 0");
-  if (camera.projection == Projection::Orthographic &&
-      !(camera.znear >= 0.0 && std::isfinite(camera.znear)))
+  if (camera.projection == Projection::Orthographic && !(camera.znear >= 0.0 && std::isfinite(camera.znear)))
     badOption("--znear", "znear must be finite and >= 0 for an orthographic camera");
-  if (!(camera.zfar > camera.znear))
-    badOption("--zfar", "zfar must be greater than znear");
+  if (!(camera.zfar > camera.znear)) badOption("--zfar", "zfar must be greater than znear");
   if (camera.projection == Projection::Orthographic && !std::isfinite(camera.zfar))
     badOption("--zfar", "an orthographic camera needs a finite zfar");
   return camera;

@@ -40,10 +40,10 @@ struct Ray {
 struct Camera {
   Projection projection = Projection::Perspective;
   int width = 0, height = 0;
-  double yfov = 0.0;    // radians (perspective)
-  double aspect = 1.0;  // the file's aspectRatio, else width / height
-  double xmag = 1.0, ymag = 1.0;  // orthographic half extents
-  double znear = 0.0, zfar = 0.0; // zfar may be +inf (perspective only)
+  double yfov = 0.0;               // radians (perspective)
+  double aspect = 1.0;             // the file's aspectRatio, else width / height
+  double xmag = 1.0, ymag = 1.0;   // orthographic half extents
+  double znear = 0.0, zfar = 0.0;  // zfar may be +inf (perspective only)
   glm::dmat4 worldFromView{1.0};
   glm::dmat4 viewFromWorld{1.0};
   std::string origin;  // where the camera came from, for `info` and reports

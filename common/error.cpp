@@ -6,8 +6,7 @@
 namespace rastray {
 
 namespace {
-std::string joinWhere(const std::string& file, const std::string& element,
-                      const std::string& message) {
+std::string joinWhere(const std::string& file, const std::string& element, const std::string& message) {
   std::string s = file;
   if (!element.empty()) s += ": " + element;
   return s + ": " + message;

@@ -27,11 +27,10 @@ class InputError : public std::runtime_error {
 // Internal invariant check that prints the values involved; on in every
 // build (Release keeps assertions), because a wrong image is worse than a
 // stopped one.
-[[noreturn]] void checkFailed(const char* expr, const char* file, int line,
-                              const std::string& detail);
+[[noreturn]] void checkFailed(const char* expr, const char* file, int line, const std::string& detail);
 
-#define RASTRAY_CHECK(cond, detail)                                   \
-  do {                                                                \
+#define RASTRAY_CHECK(cond, detail)                                           \
+  do {                                                                        \
     if (!(cond)) ::rastray::checkFailed(#cond, __FILE__, __LINE__, (detail)); \
   } while (0)
 

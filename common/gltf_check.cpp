@@ -19,22 +19,30 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int64_t kMaxZeroFilledElements = int64_t(1) << 24;
 
 constexpr const char* kSupportedExtensions[] = {
-    "KHR_lights_punctual",          "KHR_materials_transmission",
-    "KHR_materials_ior",            "KHR_materials_emissive_strength",
+    "KHR_lights_punctual",   "KHR_materials_transmission",
+    "KHR_materials_ior",     "KHR_materials_emissive_strength",
     "KHR_mesh_quantization",
 };
 
 const char* typeName(const json& v) {
   switch (v.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::object: return "an object";
-    case json::value_t::array: return "an array";
-    case json::value_t::string: return "a string";
-    case json::value_t::boolean: return "a boolean";
+    case json::value_t::null:
+      return "null";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::boolean:
+      return "a boolean";
     case json::value_t::number_integer:
-    case json::value_t::number_unsigned: return "an integer";
-    case json::value_t::number_float: return "a number";
-    default: return "an unknown value";
+    case json::value_t::number_unsigned:
+      return "an integer";
+    case json::value_t::number_float:
+      return "a number";
+    default:
+      return "an unknown value";
   }
 }
 
@@ -66,8 +74,7 @@ class Checker {
   const json* objectArray(const json& obj, const char* key, const std::string& element) const {
     const json* v = member(obj, key);
     if (!v) return nullptr;
-    if (!v->is_array())
-      fail(element, std::string("\"") + key + "\" must be an array, got " + typeName(*v));
+    if (!v->is_array()) fail(element, std::string("\"") + key + "\" must be an array, got " + typeName(*v));
     return v;
   }
 
@@ -96,9 +103,8 @@ class Checker {
                 bool required = false) const {
     const int64_t i = integer(obj, key, element, required);
     if (i >= 0 && size_t(i) >= countOf(target))
-      fail(element, std::string("\"") + key + "\" refers to " + singular(target) + " " +
-                        std::to_string(i) + ", which does not exist (" +
-                        std::to_string(countOf(target)) + " " + target + ")");
+      fail(element, std::string("\"") + key + "\" refers to " + singular(target) + " " + std::to_string(i) +
+                        ", which does not exist (" + std::to_string(countOf(target)) + " " + target + ")");
     return i;
   }
 
@@ -109,8 +115,7 @@ class Checker {
       if (required) fail(element, std::string("\"") + key + "\" is missing");
       return fallback;
     }
-    if (!v->is_number())
-      fail(element, std::string("\"") + key + "\" must be a number, got " + typeName(*v));
+    if (!v->is_number()) fail(element, std::string("\"") + key + "\" must be a number, got " + typeName(*v));
     const double d = v->get<double>();
     if (!std::isfinite(d)) fail(element, std::string("\"") + key + "\" is not finite");
     return d;
@@ -120,18 +125,16 @@ class Checker {
                    size_t maxSize) const {
     const json* v = member(obj, key);
     if (!v) return;
-    if (!v->is_array())
-      fail(element, std::string("\"") + key + "\" must be an array, got " + typeName(*v));
+    if (!v->is_array()) fail(element, std::string("\"") + key + "\" must be an array, got " + typeName(*v));
     if (v->size() < minSize || v->size() > maxSize)
-      fail(element, std::string("\"") + key + "\" has " + std::to_string(v->size()) +
-                        " entries, expected " +
+      fail(element, std::string("\"") + key + "\" has " + std::to_string(v->size()) + " entries, expected " +
                         (minSize == maxSize ? std::to_string(minSize)
                                             : std::to_string(minSize) + " to " + std::to_string(maxSize)));
     for (size_t i = 0; i < v->size(); ++i) {
       const json& e = (*v)[i];
       if (!e.is_number())
-        fail(element, std::string("\"") + key + "\"[" + std::to_string(i) + "] must be a number, got " +
-                          typeName(e));
+        fail(element,
+             std::string("\"") + key + "\"[" + std::to_string(i) + "] must be a number, got " + typeName(e));
       if (!std::isfinite(e.get<double>()))
         fail(element, std::string("\"") + key + "\"[" + std::to_string(i) + "] is not finite");
     }
@@ -143,8 +146,7 @@ class Checker {
       if (required) fail(element, std::string("\"") + key + "\" is missing");
       return {};
     }
-    if (!v->is_string())
-      fail(element, std::string("\"") + key + "\" must be a string, got " + typeName(*v));
+    if (!v->is_string()) fail(element, std::string("\"") + key + "\" must be a string, got " + typeName(*v));
     return v->get<std::string>();
   }
 
@@ -187,10 +189,17 @@ bool fits(int64_t offset, int64_t size, int64_t limit) {
 
 int64_t componentSize(int64_t componentType) {
   switch (componentType) {
-    case 5120: case 5121: return 1;
-    case 5122: case 5123: return 2;
-    case 5125: case 5126: return 4;
-    default: return 0;
+    case 5120:
+    case 5121:
+      return 1;
+    case 5122:
+    case 5123:
+      return 2;
+    case 5125:
+    case 5126:
+      return 4;
+    default:
+      return 0;
   }
 }
 
@@ -236,8 +245,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
     for (const json& name : *list) {
       if (!name.is_string()) c.fail(key, std::string("entries must be strings, got ") + typeName(name));
       if (std::string(key) == "extensionsRequired" && !isSupportedExtension(name.get<std::string>()))
-        c.fail(key, name.get<std::string>() + " is required but not supported (supported: " +
-                        supportedExtensionList() + ")");
+        c.fail(key, name.get<std::string>() +
+                        " is required but not supported (supported: " + supportedExtensionList() + ")");
     }
   }
 
@@ -292,7 +301,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       const int64_t offset = c.integer(a, "byteOffset", e, false, 0);
       const int64_t componentType = c.integer(a, "componentType", e, true);
       const int64_t size = componentSize(componentType);
-      if (size == 0) c.fail(e, "\"componentType\" " + std::to_string(componentType) + " is not a glTF component type");
+      if (size == 0)
+        c.fail(e, "\"componentType\" " + std::to_string(componentType) + " is not a glTF component type");
       c.boolean(a, "normalized", e);
       const int64_t count = c.integer(a, "count", e, true);
       if (count < 1) c.fail(e, "\"count\" must be at least 1");
@@ -323,7 +333,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
         c.object(*sparse, se);
         const int64_t sparseCount = c.integer(*sparse, "count", se, true);
         if (sparseCount < 1 || sparseCount > count)
-          c.fail(se, "\"count\" " + std::to_string(sparseCount) + " must lie in [1, " + std::to_string(count) + "]");
+          c.fail(se, "\"count\" " + std::to_string(sparseCount) + " must lie in [1, " +
+                         std::to_string(count) + "]");
         const json* indices = c.member(*sparse, "indices");
         const json* values = c.member(*sparse, "values");
         if (!indices) c.fail(se, "\"indices\" is missing");
@@ -360,7 +371,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       const std::string e = "sampler " + std::to_string(i);
       const json& s = c.object((*samplers)[i], e);
       const int64_t mag = c.integer(s, "magFilter", e, false);
-      if (mag >= 0 && mag != 9728 && mag != 9729) c.fail(e, "\"magFilter\" " + std::to_string(mag) + " is not 9728 or 9729");
+      if (mag >= 0 && mag != 9728 && mag != 9729)
+        c.fail(e, "\"magFilter\" " + std::to_string(mag) + " is not 9728 or 9729");
       const int64_t min = c.integer(s, "minFilter", e, false);
       if (min >= 0 && !(min == 9728 || min == 9729 || (min >= 9984 && min <= 9987)))
         c.fail(e, "\"minFilter\" " + std::to_string(min) + " is not a glTF filter");
@@ -429,7 +441,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       const json& m = c.object((*meshes)[i], e);
       const json* primitives = c.member(m, "primitives");
       if (!primitives) c.fail(e, "\"primitives\" is missing");
-      if (!primitives->is_array()) c.fail(e, std::string("\"primitives\" must be an array, got ") + typeName(*primitives));
+      if (!primitives->is_array())
+        c.fail(e, std::string("\"primitives\" must be an array, got ") + typeName(*primitives));
       for (size_t p = 0; p < primitives->size(); ++p) {
         const std::string pe = e + " primitive " + std::to_string(p);
         const json& prim = c.object((*primitives)[p], pe);
@@ -497,7 +510,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
             c.fail(e, "\"type\" \"" + type + "\" is not point, spot or directional");
           c.numberArray(l, "color", e, 3, 3);
           if (c.number(l, "intensity", e, false, 1.0) < 0.0) c.fail(e, "\"intensity\" must be >= 0");
-          if (c.member(l, "range") && !(c.number(l, "range", e, false) > 0.0)) c.fail(e, "\"range\" must be > 0");
+          if (c.member(l, "range") && !(c.number(l, "range", e, false) > 0.0))
+            c.fail(e, "\"range\" must be > 0");
           if (type == "spot") {
             const json* spot = c.member(l, "spot");
             if (!spot) c.fail(e, "\"spot\" is missing");
@@ -521,7 +535,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       c.index(n, "mesh", e, "meshes");
       c.index(n, "skin", e, "skins");
       if (const json* children = c.member(n, "children")) {
-        if (!children->is_array()) c.fail(e, std::string("\"children\" must be an array, got ") + typeName(*children));
+        if (!children->is_array())
+          c.fail(e, std::string("\"children\" must be an array, got ") + typeName(*children));
         for (size_t k = 0; k < children->size(); ++k) {
           const json& child = (*children)[k];
           if (!child.is_number_integer() || child.get<int64_t>() < 0 ||
@@ -544,7 +559,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
           const int64_t light = c.integer(*lp, "light", e + " KHR_lights_punctual", true);
           if (size_t(light) >= lightCount)
             c.fail(e + " KHR_lights_punctual", "\"light\" refers to light " + std::to_string(light) +
-                                                  ", which does not exist (" + std::to_string(lightCount) + " lights)");
+                                                   ", which does not exist (" + std::to_string(lightCount) +
+                                                   " lights)");
         }
       }
     }

@@ -17,8 +17,8 @@
 namespace rastray {
 
 struct GltfCheckContext {
-  std::string file;     // for messages
-  bool isGlb = false;   // buffer 0 may then omit its uri
+  std::string file;         // for messages
+  bool isGlb = false;       // buffer 0 may then omit its uri
   uint64_t glbBinSize = 0;  // size of the GLB BIN chunk (0: none)
 };
 

@@ -40,8 +40,7 @@ const char* const kSample = "id.sample";
 
 std::string lowercaseExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -118,11 +117,10 @@ uint8_t toByte(float unit) { return uint8_t(unit * 255.0f + 0.5f); }
 
 void checkFlat(const FlatImage& image) {
   const size_t n = size_t(image.width) * size_t(image.height);
-  RASTRAY_CHECK(image.width >= 0 && image.height >= 0 && image.color.size() == n &&
-                    image.depth.size() == n && image.instance.size() == n &&
-                    image.triangle.size() == n,
-                "FlatImage " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                    " with " + std::to_string(image.color.size()) + " colours");
+  RASTRAY_CHECK(image.width >= 0 && image.height >= 0 && image.color.size() == n && image.depth.size() == n &&
+                    image.instance.size() == n && image.triangle.size() == n,
+                "FlatImage " + std::to_string(image.width) + "x" + std::to_string(image.height) + " with " +
+                    std::to_string(image.color.size()) + " colours");
 }
 
 std::unique_ptr<OIIO::ImageInput> openExr(const std::string& path) {
@@ -175,9 +173,7 @@ Windows windowsOf(const OIIO::ImageSpec& spec) {
   return w;
 }
 
-std::string pixelName(int x, int y) {
-  return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
-}
+std::string pixelName(int x, int y) { return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")"; }
 
 // Other renderers may store IDs as half or float. We take them when the
 // value is an integer in uint32 range; 2^32 is what 0xFFFFFFFF rounds to in
@@ -196,9 +192,8 @@ bool idFromReal(double v, uint32_t& id) {
 [[noreturn]] void badId(const std::string& path, const char* channel, double v, int x, int y) {
   char value[64];
   std::snprintf(value, sizeof value, "%.17g", v);
-  throw InputError(
-      path, std::string("channel ") + channel,
-      std::string("value ") + value + " at " + pixelName(x, y) + " is not an integer id");
+  throw InputError(path, std::string("channel ") + channel,
+                   std::string("value ") + value + " at " + pixelName(x, y) + " is not an integer id");
 }
 
 // Reads one channel of the native pixel buffer into `dst` (one value every
@@ -209,14 +204,14 @@ void convertChannel(const OIIO::ImageSpec& spec, const std::vector<char>& native
   for (int k = 0; k < c; ++k) offset += spec.channelformat(k).size();
   const OIIO::stride_t pixelBytes = OIIO::stride_t(spec.pixel_bytes(true));
   OIIO::convert_image(1, spec.width, spec.height, 1, native.data() + offset, spec.channelformat(c),
-                      pixelBytes, pixelBytes * spec.width, OIIO::AutoStride, dst, dstType,
-                      dstStride, dstStride * spec.width, OIIO::AutoStride);
+                      pixelBytes, pixelBytes * spec.width, OIIO::AutoStride, dst, dstType, dstStride,
+                      dstStride * spec.width, OIIO::AutoStride);
 }
 
 // IDs: UINT channels are copied bit for bit (OIIO would otherwise scale
 // integers as normalized values); half/float go through idFromReal.
-void readIdChannel(const std::string& path, const OIIO::ImageSpec& spec,
-                   const std::vector<char>& native, const char* name, std::vector<uint32_t>& ids) {
+void readIdChannel(const std::string& path, const OIIO::ImageSpec& spec, const std::vector<char>& native,
+                   const char* name, std::vector<uint32_t>& ids) {
   const int c = spec.channelindex(name);
   if (c < 0) return;  // stays kNoId
   const OIIO::TypeDesc type = spec.channelformat(c);
@@ -323,15 +318,13 @@ void writePng(const std::string& path, const FlatImage& image) {
   // The bytes are already straight: without this OIIO would un-premultiply
   // them a second time.
   spec.attribute("oiio:UnassociatedAlpha", 1);
-  writeAtomically(path, "png", spec, [&](OIIO::ImageOutput& out) {
-    return out.write_image(OIIO::TypeUInt8, rgba.data());
-  });
+  writeAtomically(path, "png", spec,
+                  [&](OIIO::ImageOutput& out) { return out.write_image(OIIO::TypeUInt8, rgba.data()); });
 }
 
 void writeExr(const std::string& path, const FlatImage& image, ColorPrecision precision) {
   checkFlat(image);
-  const OIIO::TypeDesc colorType =
-      precision == ColorPrecision::Float ? OIIO::TypeFloat : OIIO::TypeHalf;
+  const OIIO::TypeDesc colorType = precision == ColorPrecision::Float ? OIIO::TypeFloat : OIIO::TypeHalf;
   OIIO::ImageSpec spec(image.width, image.height, 7, OIIO::TypeFloat);
   spec.channelnames = {kR, kG, kB, kA, kZ, kInstance, kTriangle};
   spec.channelformats = {colorType,       colorType,        colorType,       colorType,
@@ -348,8 +341,8 @@ void writeExr(const std::string& path, const FlatImage& image, ColorPrecision pr
   const OIIO::stride_t rowBytes = pixelBytes * image.width;
   std::vector<char> native(size_t(rowBytes) * size_t(image.height));
   char* p = native.data();
-  const auto convert = [&](int nchannels, const void* src, OIIO::TypeDesc type,
-                           OIIO::stride_t srcStride, OIIO::TypeDesc dstType) {
+  const auto convert = [&](int nchannels, const void* src, OIIO::TypeDesc type, OIIO::stride_t srcStride,
+                           OIIO::TypeDesc dstType) {
     OIIO::convert_image(nchannels, image.width, image.height, 1, src, type, srcStride,
                         srcStride * image.width, OIIO::AutoStride, p, dstType, pixelBytes, rowBytes,
                         OIIO::AutoStride);
@@ -360,17 +353,16 @@ void writeExr(const std::string& path, const FlatImage& image, ColorPrecision pr
   convert(1, image.instance.data(), OIIO::TypeUInt32, sizeof(uint32_t), OIIO::TypeUInt32);
   convert(1, image.triangle.data(), OIIO::TypeUInt32, sizeof(uint32_t), OIIO::TypeUInt32);
 
-  writeAtomically(path, "openexr", spec, [&](OIIO::ImageOutput& out) {
-    return out.write_image(OIIO::TypeUnknown, native.data());
-  });
+  writeAtomically(path, "openexr", spec,
+                  [&](OIIO::ImageOutput& out) { return out.write_image(OIIO::TypeUnknown, native.data()); });
 }
 
 void writeDeepExr(const std::string& path, const DeepImage& image) {
   const size_t pixels = size_t(image.width) * size_t(image.height);
   RASTRAY_CHECK(image.width >= 0 && image.height >= 0 && image.offsets.size() == pixels + 1 &&
                     image.offsets.front() == 0 && image.offsets.back() == image.samples.size(),
-                "DeepImage " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                    " with " + std::to_string(image.offsets.size()) + " offsets and " +
+                "DeepImage " + std::to_string(image.width) + "x" + std::to_string(image.height) + " with " +
+                    std::to_string(image.offsets.size()) + " offsets and " +
                     std::to_string(image.samples.size()) + " samples");
 
   // Colour is float, not half: deep files are for sample-exact analysis.
@@ -386,8 +378,7 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
   OIIO::DeepData deep(spec);
   std::vector<unsigned int> counts(pixels);
   for (size_t i = 0; i < pixels; ++i) {
-    RASTRAY_CHECK(image.offsets[i] <= image.offsets[i + 1],
-                  "offsets[" + std::to_string(i) + "] decreases");
+    RASTRAY_CHECK(image.offsets[i] <= image.offsets[i + 1], "offsets[" + std::to_string(i) + "] decreases");
     counts[i] = image.offsets[i + 1] - image.offsets[i];
   }
   deep.set_all_samples(counts);
@@ -403,8 +394,7 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
       deep.set_deep_value(px, 7, si, d.sample);
     }
   }
-  writeAtomically(path, "openexr", spec,
-                  [&](OIIO::ImageOutput& out) { return out.write_deep_image(deep); });
+  writeAtomically(path, "openexr", spec, [&](OIIO::ImageOutput& out) { return out.write_deep_image(deep); });
 }
 
 bool isDeepExr(const std::string& path) { return openExr(path)->spec().deep; }
@@ -513,8 +503,8 @@ DeepImage readDeepExrUnchecked(const std::string& path) {
       const int n = deep.samples(px);
       for (int s = 0; s < n; ++s) {
         DeepSample& d = out[s];
-        d.color = {deep.deep_value(px, cR, s), deep.deep_value(px, cG, s),
-                   deep.deep_value(px, cB, s), cA >= 0 ? deep.deep_value(px, cA, s) : 1.0f};
+        d.color = {deep.deep_value(px, cR, s), deep.deep_value(px, cG, s), deep.deep_value(px, cB, s),
+                   cA >= 0 ? deep.deep_value(px, cA, s) : 1.0f};
         d.depth = cZ >= 0 ? deep.deep_value(px, cZ, s) : kInf;
         d.instance = deepId(path, deep, cInstance, kInstance, kNoId, px, s, x, y);
         d.triangle = deepId(path, deep, cTriangle, kTriangle, kNoId, px, s, x, y);
@@ -545,8 +535,6 @@ auto readWithinMemory(const std::string& path, Read read) -> decltype(read(path)
 
 FlatImage readExr(const std::string& path) { return readWithinMemory(path, readExrUnchecked); }
 
-DeepImage readDeepExr(const std::string& path) {
-  return readWithinMemory(path, readDeepExrUnchecked);
-}
+DeepImage readDeepExr(const std::string& path) { return readWithinMemory(path, readDeepExrUnchecked); }
 
 }  // namespace rastray

@@ -44,7 +44,7 @@ struct DeepSample {
   glm::vec4 color{0.0f};  // linear, premultiplied: this layer's own contribution
   float depth = 0.0f;     // view depth
   uint32_t instance = 0, triangle = 0;
-  uint32_t sample = 0;    // index in the SPEC §3 sample pattern
+  uint32_t sample = 0;  // index in the SPEC §3 sample pattern
 };
 
 // Deep frame: pixel i owns samples[offsets[i], offsets[i + 1]), sorted by

@@ -19,7 +19,7 @@ struct CounterSet {
   void set(const std::string& name, uint64_t value);
   void add(const std::string& name, uint64_t value);
   uint64_t get(const std::string& name) const;  // 0 when absent
-  void merge(const CounterSet& other);           // adds, keeping first-seen order
+  void merge(const CounterSet& other);          // adds, keeping first-seen order
 };
 
 struct RenderOutput {

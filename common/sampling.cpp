@@ -11,11 +11,9 @@ namespace {
 // Direct3D 11 standard sample patterns, in 1/16 pixel from the centre.
 constexpr int kPattern2[][2] = {{4, 4}, {-4, -4}};
 constexpr int kPattern4[][2] = {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}};
-constexpr int kPattern8[][2] = {{1, -3}, {-1, 3}, {5, 1},  {-3, -5},
-                                {-5, 5}, {-7, -1}, {3, 7}, {7, -7}};
-constexpr int kPattern16[][2] = {{1, 1},   {-1, -3}, {-3, 2},  {4, -1}, {-5, -2}, {2, 5},
-                                 {5, 3},   {3, -5},  {-2, 6},  {0, -7}, {-4, -6}, {-6, 4},
-                                 {-8, 0},  {7, -4},  {6, 7},   {-7, -8}};
+constexpr int kPattern8[][2] = {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}};
+constexpr int kPattern16[][2] = {{1, 1},  {-1, -3}, {-3, 2},  {4, -1}, {-5, -2}, {2, 5},  {5, 3}, {3, -5},
+                                 {-2, 6}, {0, -7},  {-4, -6}, {-6, 4}, {-8, 0},  {7, -4}, {6, 7}, {-7, -8}};
 
 template <size_t N>
 std::vector<glm::dvec2> fromPattern(const int (&pattern)[N][2]) {
@@ -39,12 +37,18 @@ std::string supportedSampleCounts() { return "1, 2, 4, 8, 16 or n*n for n > 4"; 
 
 std::vector<glm::dvec2> samplePositions(int spp) {
   switch (spp) {
-    case 1: return {glm::dvec2(0.5, 0.5)};
-    case 2: return fromPattern(kPattern2);
-    case 4: return fromPattern(kPattern4);
-    case 8: return fromPattern(kPattern8);
-    case 16: return fromPattern(kPattern16);
-    default: break;
+    case 1:
+      return {glm::dvec2(0.5, 0.5)};
+    case 2:
+      return fromPattern(kPattern2);
+    case 4:
+      return fromPattern(kPattern4);
+    case 8:
+      return fromPattern(kPattern8);
+    case 16:
+      return fromPattern(kPattern16);
+    default:
+      break;
   }
   const int n = gridSide(spp);
   if (n == 0)

@@ -90,7 +90,7 @@ struct Light {
   float range = 0.0f;      // 0: infinite
   float innerConeAngle = 0.0f;
   float outerConeAngle = 0.7853981634f;  // π/4, the glTF default
-  glm::dvec3 position{0.0};   // world space (point, spot)
+  glm::dvec3 position{0.0};              // world space (point, spot)
   glm::dvec3 direction{0.0, 0.0, -1.0};  // world, unit: the way light travels (node's −Z)
   uint32_t node = 0;
 };
@@ -106,8 +106,8 @@ struct CameraModel {
   double xmag = 1.0, ymag = 1.0;     // half extents (orthographic)
   double znear = 0.1;
   double zfar = std::numeric_limits<double>::infinity();
-  glm::dmat4 worldFromCamera{1.0};   // camera looks down −Z, +Y up
-  std::string origin;                // e.g. "node 3 'Camera' (camera 0)" or "default"
+  glm::dmat4 worldFromCamera{1.0};  // camera looks down −Z, +Y up
+  std::string origin;               // e.g. "node 3 'Camera' (camera 0)" or "default"
 };
 
 struct Bounds {
@@ -132,7 +132,7 @@ struct Instance {
   uint32_t material = 0;   // index into Scene::materials (always valid)
   int mode = 4;            // glTF primitive mode: 4 TRIANGLES, 5 STRIP, 6 FAN
   glm::dmat4 worldFromObject{1.0};
-  bool mirrored = false;   // det(worldFromObject) < 0: winding was swapped
+  bool mirrored = false;  // det(worldFromObject) < 0: winding was swapped
   NormalSource normals = NormalSource::Flat;
   bool hasTexcoords = false;  // false: texcoords are all (0, 0)
   uint32_t firstVertex = 0, vertexCount = 0;
@@ -142,13 +142,13 @@ struct Instance {
 
 // Counts of what the file holds, for `rastray info`.
 struct SceneFileStats {
-  uint32_t nodes = 0;          // nodes in the file
-  uint32_t visitedNodes = 0;   // nodes reached from the scene's roots
+  uint32_t nodes = 0;         // nodes in the file
+  uint32_t visitedNodes = 0;  // nodes reached from the scene's roots
   uint32_t meshes = 0;
-  uint32_t cameras = 0;        // camera definitions in the file
-  uint32_t cameraNodes = 0;    // visited nodes that carry a camera
+  uint32_t cameras = 0;            // camera definitions in the file
+  uint32_t cameraNodes = 0;        // visited nodes that carry a camera
   uint32_t skippedPrimitives = 0;  // points and lines: no instance number
-  int sceneIndex = -1;         // -1: no scenes, all root nodes used
+  int sceneIndex = -1;             // -1: no scenes, all root nodes used
 };
 
 struct Scene {
@@ -156,9 +156,9 @@ struct Scene {
 
   // The triangle store (see the conventions above).
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;    // unit; (0,0,0) where NormalSource::Flat
-  std::vector<glm::vec2> texcoords;  // the set the base colour texture reads
-  std::vector<glm::uvec3> triangles; // absolute indices into the vertex arrays
+  std::vector<glm::vec3> normals;     // unit; (0,0,0) where NormalSource::Flat
+  std::vector<glm::vec2> texcoords;   // the set the base colour texture reads
+  std::vector<glm::uvec3> triangles;  // absolute indices into the vertex arrays
   std::vector<Instance> instances;
 
   std::vector<Material> materials;
@@ -175,9 +175,7 @@ struct Scene {
   const glm::uvec3& triangle(uint32_t instance, uint32_t tri) const {
     return triangles[instances[instance].firstTriangle + tri];
   }
-  const Material& materialOf(uint32_t instance) const {
-    return materials[instances[instance].material];
-  }
+  const Material& materialOf(uint32_t instance) const { return materials[instances[instance].material]; }
   size_t triangleCount() const { return triangles.size(); }
 };
 

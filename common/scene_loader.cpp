@@ -15,11 +15,11 @@
 #include <fstream>
 #include <sstream>
 
+#include <tiny_gltf.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
-#include <tiny_gltf.h>
 
 #include "common/error.h"
 #include "common/gltf_check.h"
@@ -32,7 +32,7 @@ namespace {
 using json = nlohmann::json;
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr uint32_t kGlbMagic = 0x46546C67;   // "glTF"
 constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
 constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
 
@@ -59,10 +59,9 @@ std::string shortened(std::string text) {
 }
 
 // The glTF top-level arrays whose entries messages name as elements.
-constexpr const char* kElementArrays[] = {"accessors", "animations", "buffers", "bufferViews",
-                                          "cameras",   "images",     "materials", "meshes",
-                                          "nodes",     "samplers",   "scenes",    "skins",
-                                          "textures"};
+constexpr const char* kElementArrays[] = {"accessors", "animations", "buffers", "bufferViews", "cameras",
+                                          "images",    "materials",  "meshes",  "nodes",       "samplers",
+                                          "scenes",    "skins",      "textures"};
 
 // "nodes" -> "node"; empty for a key that is not one of kElementArrays.
 std::string singular(const std::string& key) {
@@ -118,9 +117,9 @@ class TrackingJsonParser : public nlohmann::detail::json_sax_dom_parser<json> {
       column = text_[i] == '\n' ? 0 : column + 1;
       line += text_[i] == '\n';
     }
-    throw InputError(path_, element(), "invalid JSON at line " + std::to_string(line) +
-                                           ", column " + std::to_string(column) + where() +
-                                           ": " + detail);
+    throw InputError(path_, element(),
+                     "invalid JSON at line " + std::to_string(line) + ", column " + std::to_string(column) +
+                         where() + ": " + detail);
   }
 
  private:
@@ -136,8 +135,8 @@ class TrackingJsonParser : public nlohmann::detail::json_sax_dom_parser<json> {
   void open(bool isArray) {
     value();
     if (frames_.size() >= kMaxJsonDepth)
-      throw InputError(path_, element(), "JSON nesting is deeper than " +
-                                             std::to_string(kMaxJsonDepth) + " levels");
+      throw InputError(path_, element(),
+                       "JSON nesting is deeper than " + std::to_string(kMaxJsonDepth) + " levels");
     frames_.push_back({isArray, "", 0});
   }
   // Position of frame i's current member: a key, or the index of the
@@ -161,8 +160,7 @@ class TrackingJsonParser : public nlohmann::detail::json_sax_dom_parser<json> {
   std::string where() const {
     std::string s;
     for (size_t i = inArrayEntry() ? 2 : 1; i < frames_.size(); ++i)
-      s += frames_[i].isArray ? "[" + step(i) + "]"
-                              : (s.empty() ? "" : ".") + ("\"" + step(i) + "\"");
+      s += frames_[i].isArray ? "[" + step(i) + "]" : (s.empty() ? "" : ".") + ("\"" + step(i) + "\"");
     return s.empty() ? s : " (" + s + ")";
   }
 
@@ -230,13 +228,38 @@ class SceneBuilder {
 // Component read with glTF normalisation rules (glTF 2.0 §3.11).
 double readComponent(const uint8_t* p, int64_t componentType, bool normalized) {
   switch (componentType) {
-    case 5120: { int8_t v; std::memcpy(&v, p, 1); return normalized ? std::max(v / 127.0, -1.0) : v; }
-    case 5121: { uint8_t v; std::memcpy(&v, p, 1); return normalized ? v / 255.0 : v; }
-    case 5122: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
-    case 5123: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
-    case 5125: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? v / 4294967295.0 : v; }
-    case 5126: { float v; std::memcpy(&v, p, 4); return v; }
-    default: return 0.0;
+    case 5120: {
+      int8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case 5121: {
+      uint8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? v / 255.0 : v;
+    }
+    case 5122: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case 5123: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0 : v;
+    }
+    case 5125: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return normalized ? v / 4294967295.0 : v;
+    }
+    case 5126: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    default:
+      return 0.0;
   }
 }
 
@@ -260,8 +283,8 @@ std::vector<double> SceneBuilder::readAccessor(int64_t index, const std::string&
   *components = n;
   std::vector<double> out(count * n, 0.0);  // no bufferView: zeros (glTF)
 
-  auto readView = [&](int64_t view, size_t byteOffset, size_t stride, size_t elements, size_t elementComponents,
-                      int64_t ctype, bool norm, double* dst) {
+  auto readView = [&](int64_t view, size_t byteOffset, size_t stride, size_t elements,
+                      size_t elementComponents, int64_t ctype, bool norm, double* dst) {
     const json& v = array("bufferViews")[size_t(view)];
     const auto& data = model_.buffers[v.at("buffer").get<size_t>()].data;
     const size_t base = get<size_t>(v, "byteOffset", 0) + byteOffset;
@@ -286,8 +309,8 @@ std::vector<double> SceneBuilder::readAccessor(int64_t index, const std::string&
     const int64_t ict = si.at("componentType").get<int64_t>();
     readView(si.at("bufferView").get<int64_t>(), get<size_t>(si, "byteOffset", 0), componentBytes(ict),
              sparseCount, 1, ict, false, indices.data());
-    readView(sv.at("bufferView").get<int64_t>(), get<size_t>(sv, "byteOffset", 0), n * cbytes, sparseCount,
-             n, componentType, normalized, values.data());
+    readView(sv.at("bufferView").get<int64_t>(), get<size_t>(sv, "byteOffset", 0), n * cbytes, sparseCount, n,
+             componentType, normalized, values.data());
     for (size_t k = 0; k < sparseCount; ++k) {
       const double i = indices[k];
       if (!(i < double(count)))
@@ -533,7 +556,8 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
       n = len > 0.0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);  // zero: use the face normal
     }
     scene_.normals.emplace_back(n);
-    scene_.texcoords.emplace_back(uv.empty() ? glm::vec2(0.0f) : glm::vec2(float(uv[2 * v]), float(uv[2 * v + 1])));
+    scene_.texcoords.emplace_back(uv.empty() ? glm::vec2(0.0f)
+                                             : glm::vec2(float(uv[2 * v]), float(uv[2 * v + 1])));
   }
   inst.vertexCount = uint32_t(vertexCount);
 
@@ -544,8 +568,8 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
     indices = readIndices(ia, e + " indices");
     for (uint32_t i : indices)
       if (i >= vertexCount)
-        fail("accessor " + std::to_string(ia), "index " + std::to_string(i) + " out of range (" +
-                                                   std::to_string(vertexCount) + " vertices)");
+        fail("accessor " + std::to_string(ia),
+             "index " + std::to_string(i) + " out of range (" + std::to_string(vertexCount) + " vertices)");
   } else {
     indices.resize(vertexCount);
     for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
@@ -564,7 +588,8 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
   } else {
     for (size_t i = 0; i + 2 < n; ++i) tris.emplace_back(indices[0], indices[i + 1], indices[i + 2]);
   }
-  if (scene_.triangles.size() + tris.size() >= size_t(kNoId)) fail(e, "the scene has more than 2^32 triangles");
+  if (scene_.triangles.size() + tris.size() >= size_t(kNoId))
+    fail(e, "the scene has more than 2^32 triangles");
   for (glm::uvec3 t : tris) {
     if (inst.mirrored) std::swap(t.y, t.z);  // keep CCW = front in world space
     t += glm::uvec3(inst.firstVertex);
@@ -609,7 +634,8 @@ void SceneBuilder::addCamera(size_t node, const glm::dmat4& world) {
 }
 
 void SceneBuilder::addLight(size_t node, const glm::dmat4& world) {
-  const size_t index = array("nodes")[node].at("extensions").at("KHR_lights_punctual").at("light").get<size_t>();
+  const size_t index =
+      array("nodes")[node].at("extensions").at("KHR_lights_punctual").at("light").get<size_t>();
   const json& l = doc_.at("extensions").at("KHR_lights_punctual").at("lights")[index];
   Light light;
   light.name = get<std::string>(l, "name", "");
@@ -617,7 +643,8 @@ void SceneBuilder::addLight(size_t node, const glm::dmat4& world) {
   light.type = type == "point" ? LightType::Point : type == "spot" ? LightType::Spot : LightType::Directional;
   if (l.contains("color")) {
     const auto c = l.at("color").get<std::vector<double>>();
-    if (c[0] < 0 || c[1] < 0 || c[2] < 0) fail("light " + std::to_string(index), "\"color\" must not be negative");
+    if (c[0] < 0 || c[1] < 0 || c[2] < 0)
+      fail("light " + std::to_string(index), "\"color\" must not be negative");
     light.color = glm::vec3(float(c[0]), float(c[1]), float(c[2]));
   }
   light.intensity = float(get(l, "intensity", 1.0));
@@ -658,11 +685,15 @@ void SceneBuilder::loadTextures() {
       for (int k = 0; k < comps; ++k) {
         const size_t at = (p * size_t(comps) + size_t(k)) * size_t(bytes);
         // 16-bit: keep the high byte, rounded (65535 → 255).
-        c[k] = bytes == 1 ? src.image[at]
-                          : uint8_t((uint32_t(src.image[at]) | uint32_t(src.image[at + 1]) << 8) * 255u / 65535u);
+        c[k] = bytes == 1
+                   ? src.image[at]
+                   : uint8_t((uint32_t(src.image[at]) | uint32_t(src.image[at + 1]) << 8) * 255u / 65535u);
       }
-      if (comps == 1) c[1] = c[2] = c[0];           // grey
-      if (comps == 2) { c[3] = c[1]; c[1] = c[2] = c[0]; }  // grey + alpha
+      if (comps == 1) c[1] = c[2] = c[0];  // grey
+      if (comps == 2) {
+        c[3] = c[1];
+        c[1] = c[2] = c[0];
+      }  // grey + alpha
       std::memcpy(&img.rgba8[p * 4], c, 4);
     }
     scene_.images.push_back(std::move(img));
@@ -690,7 +721,8 @@ void SceneBuilder::loadMaterials() {
     Material mat;
     mat.name = get<std::string>(m, "name", "");
     auto unit = [&](double v, const char* what) {
-      if (!(v >= 0.0 && v <= 1.0)) fail(e, std::string(what) + " " + std::to_string(v) + " must lie in [0, 1]");
+      if (!(v >= 0.0 && v <= 1.0))
+        fail(e, std::string(what) + " " + std::to_string(v) + " must lie in [0, 1]");
       return float(v);
     };
     if (m.contains("pbrMetallicRoughness")) {
@@ -712,7 +744,8 @@ void SceneBuilder::loadMaterials() {
     glm::dvec3 emissive(0.0);
     if (m.contains("emissiveFactor")) {
       const auto f = m.at("emissiveFactor").get<std::vector<double>>();
-      emissive = glm::dvec3(unit(f[0], "emissiveFactor"), unit(f[1], "emissiveFactor"), unit(f[2], "emissiveFactor"));
+      emissive = glm::dvec3(unit(f[0], "emissiveFactor"), unit(f[1], "emissiveFactor"),
+                            unit(f[2], "emissiveFactor"));
     }
     const std::string mode = get<std::string>(m, "alphaMode", "OPAQUE");
     mat.alphaMode = mode == "MASK" ? AlphaMode::Mask : mode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
@@ -722,8 +755,8 @@ void SceneBuilder::loadMaterials() {
     if (m.contains("extensions")) {
       const json& ext = m.at("extensions");
       if (ext.contains("KHR_materials_transmission"))
-        mat.transmission = unit(get(ext.at("KHR_materials_transmission"), "transmissionFactor", 0.0),
-                                "transmissionFactor");
+        mat.transmission =
+            unit(get(ext.at("KHR_materials_transmission"), "transmissionFactor", 0.0), "transmissionFactor");
       if (ext.contains("KHR_materials_ior")) {
         const double ior = get(ext.at("KHR_materials_ior"), "ior", 1.5);
         if (!(ior >= 1.0)) fail(e + " KHR_materials_ior", "\"ior\" " + std::to_string(ior) + " must be >= 1");
@@ -774,16 +807,20 @@ Scene loadScene(const std::string& path) {
   std::string jsonText;
   if (bytes.size() >= 4 && readU32(bytes, 0) == kGlbMagic) {
     context.isGlb = true;
-    if (bytes.size() < 20) throw InputError(path, "GLB header", "file is too short (" + std::to_string(bytes.size()) + " bytes)");
+    if (bytes.size() < 20)
+      throw InputError(path, "GLB header", "file is too short (" + std::to_string(bytes.size()) + " bytes)");
     const uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8);
-    if (version != 2) throw InputError(path, "GLB header", "version " + std::to_string(version) + " is not 2");
+    if (version != 2)
+      throw InputError(path, "GLB header", "version " + std::to_string(version) + " is not 2");
     if (length != bytes.size())
-      throw InputError(path, "GLB header", "declares " + std::to_string(length) + " bytes, the file has " +
-                                               std::to_string(bytes.size()));
+      throw InputError(
+          path, "GLB header",
+          "declares " + std::to_string(length) + " bytes, the file has " + std::to_string(bytes.size()));
     const uint32_t jsonLength = readU32(bytes, 12), jsonType = readU32(bytes, 16);
     if (jsonType != kChunkJson) throw InputError(path, "GLB chunk 0", "is not a JSON chunk");
     if (jsonLength > bytes.size() - 20)
-      throw InputError(path, "GLB chunk 0", "length " + std::to_string(jsonLength) + " runs past the end of the file");
+      throw InputError(path, "GLB chunk 0",
+                       "length " + std::to_string(jsonLength) + " runs past the end of the file");
     // Chunks end on 4-byte boundaries (glTF 2.0, GLB layout); tinygltf
     // looks for the BIN chunk right after the JSON bytes, so an unpadded
     // length would have it read another chunk than the one checked here.
@@ -795,9 +832,9 @@ Scene loadScene(const std::string& path) {
     const size_t binAt = 20 + size_t(jsonLength);
     if (binAt < bytes.size()) {
       if (bytes.size() - binAt < 8)
-        throw InputError(path, "GLB chunk 1",
-                         "header is truncated (" + std::to_string(bytes.size() - binAt) +
-                             " bytes after the JSON chunk)");
+        throw InputError(
+            path, "GLB chunk 1",
+            "header is truncated (" + std::to_string(bytes.size() - binAt) + " bytes after the JSON chunk)");
       const uint32_t binLength = readU32(bytes, binAt), binType = readU32(bytes, binAt + 4);
       if (binType != kChunkBin) throw InputError(path, "GLB chunk 1", "is not a BIN chunk");
       if (binLength < 4 || binLength % 4 != 0)
@@ -828,11 +865,11 @@ Scene loadScene(const std::string& path) {
   std::string err, warn;
   const std::string baseDir = std::filesystem::path(path).parent_path().string();
   if (bytes.size() > UINT32_MAX) throw InputError(path, "", "file is larger than 4 GiB");
-  const bool ok = context.isGlb
-                      ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()),
-                                                    baseDir.empty() ? "." : baseDir)
-                      : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(), unsigned(jsonText.size()),
-                                                   baseDir.empty() ? "." : baseDir);
+  const bool ok =
+      context.isGlb ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()),
+                                                  baseDir.empty() ? "." : baseDir)
+                    : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(),
+                                                 unsigned(jsonText.size()), baseDir.empty() ? "." : baseDir);
   if (!ok) {
     // tinygltf loads the top-level arrays in this order and appends each
     // entry once it has loaded, so the first array that came up short
@@ -878,18 +915,24 @@ glm::dvec3 faceNormal(const Scene& scene, uint32_t instance, uint32_t tri) {
 
 const char* toString(AlphaMode mode) {
   switch (mode) {
-    case AlphaMode::Opaque: return "OPAQUE";
-    case AlphaMode::Mask: return "MASK";
-    case AlphaMode::Blend: return "BLEND";
+    case AlphaMode::Opaque:
+      return "OPAQUE";
+    case AlphaMode::Mask:
+      return "MASK";
+    case AlphaMode::Blend:
+      return "BLEND";
   }
   return "?";
 }
 
 const char* toString(LightType type) {
   switch (type) {
-    case LightType::Point: return "point";
-    case LightType::Spot: return "spot";
-    case LightType::Directional: return "directional";
+    case LightType::Point:
+      return "point";
+    case LightType::Spot:
+      return "spot";
+    case LightType::Directional:
+      return "directional";
   }
   return "?";
 }

@@ -13,11 +13,16 @@ constexpr double kInvPi = 0.31830988618379067154;
 
 const char* toString(RayKind kind) {
   switch (kind) {
-    case RayKind::Primary: return "primary";
-    case RayKind::Shadow: return "shadow";
-    case RayKind::Reflection: return "reflection";
-    case RayKind::Refraction: return "refraction";
-    case RayKind::Transparency: return "transparency";
+    case RayKind::Primary:
+      return "primary";
+    case RayKind::Shadow:
+      return "shadow";
+    case RayKind::Reflection:
+      return "reflection";
+    case RayKind::Refraction:
+      return "refraction";
+    case RayKind::Transparency:
+      return "transparency";
   }
   return "?";
 }
@@ -134,8 +139,9 @@ glm::vec4 Shader::shade(const SurfacePoint& p, const glm::dvec3& direction, cons
       const float refractWeight = t * float(1.0 - F);
       if (refractWeight * throughput >= options_.minThroughput) {
         if (const auto refracted = refract(direction, n, eta))
-          L += refractWeight * c *
-               secondary_->radiance(p, *refracted, RayKind::Refraction, depth + 1, throughput * refractWeight);
+          L +=
+              refractWeight * c *
+              secondary_->radiance(p, *refracted, RayKind::Refraction, depth + 1, throughput * refractWeight);
       }
     }
   }

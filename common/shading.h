@@ -64,8 +64,8 @@ class SecondaryRayTracer {
 };
 
 struct ShadingOptions {
-  int maxDepth = 8;               // secondary rays deeper than this return black
-  float minThroughput = 1e-3f;    // secondary rays with less weight are not traced
+  int maxDepth = 8;             // secondary rays deeper than this return black
+  float minThroughput = 1e-3f;  // secondary rays with less weight are not traced
   TextureFilter textureFilter = TextureFilter::Sampler;
 };
 
@@ -73,8 +73,9 @@ class Shader {
  public:
   // `visibility` may be null (everything lit); `secondary` may be null
   // (mirrors and glass then see black: the pure rasterizer has no rays).
-  Shader(const Scene& scene, const SceneAnalysis& analysis, const Camera& camera, const ShadingOptions& options,
-         const LightVisibility* visibility, const SecondaryRayTracer* secondary);
+  Shader(const Scene& scene, const SceneAnalysis& analysis, const Camera& camera,
+         const ShadingOptions& options, const LightVisibility* visibility,
+         const SecondaryRayTracer* secondary);
 
   // Straight linear RGBA base colour (factor × texture) at a point.
   glm::vec4 baseColor(const SurfacePoint& point, const TextureFootprint& footprint) const;

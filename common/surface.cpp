@@ -37,7 +37,8 @@ SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit) {
   sp.geometricNormal = length > 0.0 ? n / length : glm::dvec3(0.0, 0.0, 1.0);
   sp.shadingNormal = sp.geometricNormal;
   if (inst.normals == NormalSource::Authored) {
-    const glm::dvec3 ns = b0 * glm::dvec3(scene.normals[t.x]) + double(hit.b1) * glm::dvec3(scene.normals[t.y]) +
+    const glm::dvec3 ns = b0 * glm::dvec3(scene.normals[t.x]) +
+                          double(hit.b1) * glm::dvec3(scene.normals[t.y]) +
                           double(hit.b2) * glm::dvec3(scene.normals[t.z]);
     const double nl = glm::length(ns);
     if (nl > 0.0 && std::isfinite(nl)) sp.shadingNormal = ns / nl;  // zero: keep the face normal

@@ -12,10 +12,14 @@ namespace rastray {
 
 const char* toString(TextureFilter filter) {
   switch (filter) {
-    case TextureFilter::Sampler: return "sampler";
-    case TextureFilter::Nearest: return "nearest";
-    case TextureFilter::Bilinear: return "bilinear";
-    case TextureFilter::Trilinear: return "trilinear";
+    case TextureFilter::Sampler:
+      return "sampler";
+    case TextureFilter::Nearest:
+      return "nearest";
+    case TextureFilter::Bilinear:
+      return "bilinear";
+    case TextureFilter::Trilinear:
+      return "trilinear";
   }
   return "?";
 }
@@ -53,8 +57,9 @@ MipLevel halve(const MipLevel& src) {
 
 int wrap(int i, int n, int mode) {
   switch (mode) {
-    case 33071: return std::clamp(i, 0, n - 1);  // CLAMP_TO_EDGE
-    case 33648: {                                // MIRRORED_REPEAT
+    case 33071:
+      return std::clamp(i, 0, n - 1);  // CLAMP_TO_EDGE
+    case 33648: {                      // MIRRORED_REPEAT
       const int period = 2 * n;
       int m = i % period;
       if (m < 0) m += period;
@@ -118,7 +123,8 @@ float TextureSet::levelOfDetail(int texture, const TextureFootprint& fp) const {
   return rho > 0.0f ? std::log2(rho) : -INFINITY;
 }
 
-glm::vec4 TextureSet::sample(int texture, glm::vec2 uv, const TextureFootprint& fp, TextureFilter filter) const {
+glm::vec4 TextureSet::sample(int texture, glm::vec2 uv, const TextureFootprint& fp,
+                             TextureFilter filter) const {
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
   // Keep texel arithmetic in int range: REPEAT is periodic, and clamped
   // modes give the edge texel for any uv beyond the image anyway.

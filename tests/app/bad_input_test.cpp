@@ -124,8 +124,7 @@ const BadInput kBadInputs[] = {
     // References to elements that do not exist.
     {"mesh-index-missing.gltf", "node 0: \"mesh\" refers to mesh 5"},
     {"material-index-missing.gltf", "mesh 0 primitive 0: \"material\" refers to material 2"},
-    {"accessor-index-missing.gltf",
-     "mesh 0 primitive 0 attributes: \"NORMAL\" refers to accessor 9"},
+    {"accessor-index-missing.gltf", "mesh 0 primitive 0 attributes: \"NORMAL\" refers to accessor 9"},
 };
 
 void PrintTo(const BadInput& b, std::ostream* os) { *os << b.file; }
@@ -156,8 +155,7 @@ TEST(BadInputTable, CoversEveryMalformedFile) {
   std::set<std::string> listed;
   for (const BadInput& b : kBadInputs) EXPECT_TRUE(listed.insert(b.file).second) << b.file;
   // Side files that cases refer to; not inputs themselves.
-  const std::set<std::string> helpers{"generate.py", "buffer-short-external.bin",
-                                      "not-an-image.png"};
+  const std::set<std::string> helpers{"generate.py", "buffer-short-external.bin", "not-an-image.png"};
   size_t files = 0;
   for (const fs::directory_entry& e : fs::directory_iterator(kMalformed)) {
     if (!e.is_regular_file()) continue;
@@ -239,8 +237,7 @@ TEST(BadCommandLine, SizeWithOneValue) {
 }
 
 TEST(BadCommandLine, ImpossibleCameraOverride) {
-  const CommandResult r =
-      runRastray({"info", kScene, "--eye", "0", "0", "0", "--target", "0", "0", "0"});
+  const CommandResult r = runRastray({"info", kScene, "--eye", "0", "0", "0", "--target", "0", "0", "0"});
   expectOneLineStatus2(r);
   EXPECT_EQ(r.err.rfind("command line: --target: ", 0), 0u) << r.err;
 }

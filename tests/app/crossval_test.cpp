@@ -30,10 +30,11 @@ std::string slurp(const std::filesystem::path& p) {
 // exactly like the ray caster wherever their hits agree.
 TEST(Crossval, BundledScenesHaveNoGenuineMismatches) {
   std::vector<std::string> args = {"crossval"};
-  for (const char* s : {"three-triangles", "interpenetrating", "cyclic-overlap", "cornell-box", "transparent-layers",
-                        "textured-plane"})
+  for (const char* s : {"three-triangles", "interpenetrating", "cyclic-overlap", "cornell-box",
+                        "transparent-layers", "textured-plane"})
     args.push_back(scene(s));
-  for (const char* a : {"--size", "96", "72", "--spp", "4", "--json", "--shadow-map-size", "512"}) args.push_back(a);
+  for (const char* a : {"--size", "96", "72", "--spp", "4", "--json", "--shadow-map-size", "512"})
+    args.push_back(a);
   const auto r = runRastray(args);
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const json j = json::parse(r.out);
@@ -47,7 +48,8 @@ TEST(Crossval, BundledScenesHaveNoGenuineMismatches) {
     }
     EXPECT_LE(s["hybridVsRaytrace"]["color"]["maxWhereHitsAgree"].get<double>(), 1e-5) << s["scene"];
     // Depth agrees to float precision where the hits agree.
-    EXPECT_LT(s["rasterVsRaytrace"]["visibility"]["depthError"]["maxRelative"].get<double>(), 1e-5) << s["scene"];
+    EXPECT_LT(s["rasterVsRaytrace"]["visibility"]["depthError"]["maxRelative"].get<double>(), 1e-5)
+        << s["scene"];
   }
   EXPECT_TRUE(j["failures"].empty());
 }
@@ -56,7 +58,8 @@ TEST(Crossval, BundledScenesHaveNoGenuineMismatches) {
 // rasterizer's exact per-sample fragment lists (with traced shadows, so
 // both see the same light) to 1e-5 wherever the layer lists agree.
 TEST(Crossval, ExactTransparencyMatchesTheRayCaster) {
-  const auto r = runRastray({"crossval", scene("transparent-layers"), "--size", "120", "90", "--spp", "4", "--json"});
+  const auto r =
+      runRastray({"crossval", scene("transparent-layers"), "--size", "120", "90", "--spp", "4", "--json"});
   ASSERT_EQ(r.status, 0) << r.err;
   const json s = json::parse(r.out)["scenes"][0];
   EXPECT_GT(s["hybridVsRaytrace"]["color"]["layersWhereHitsAgree"].get<uint64_t>(), 40000u);
@@ -79,8 +82,8 @@ TEST(Crossval, ReportIsSelfContained) {
                              "--report", dir, "--shadow-map-size", "256"});
   ASSERT_EQ(r.status, 0) << r.err;
   ASSERT_TRUE(std::filesystem::exists(dir + "/index.html"));
-  for (const char* f : {"index.html", "raster.png", "raytrace.png", "hybrid.png", "mismatch.png", "depth-diff.png",
-                        "color-diff.png"})
+  for (const char* f : {"index.html", "raster.png", "raytrace.png", "hybrid.png", "mismatch.png",
+                        "depth-diff.png", "color-diff.png"})
     EXPECT_TRUE(std::filesystem::exists(dir + "/cornell-box/" + f)) << f;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
     if (entry.path().extension() != ".html") continue;
@@ -104,8 +107,10 @@ TEST(Crossval, ReportIsSelfContained) {
   const std::string cmd = std::string(chromium) +
                           " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
                           "--disable-background-networking --disable-component-update --disable-sync "
-                          "--user-data-dir=" + profile + " --window-size=1200,1600 --screenshot=" + shot + " file://" +
-                          std::filesystem::absolute(dir + "/cornell-box/index.html").string() + " >/dev/null 2>&1";
+                          "--user-data-dir=" +
+                          profile + " --window-size=1200,1600 --screenshot=" + shot + " file://" +
+                          std::filesystem::absolute(dir + "/cornell-box/index.html").string() +
+                          " >/dev/null 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   ASSERT_TRUE(std::filesystem::exists(shot));
   // A page that rendered its images is far from a blank screenshot.
@@ -114,7 +119,8 @@ TEST(Crossval, ReportIsSelfContained) {
 }
 
 TEST(Explain, ShowsBothRenderersAndTheirHits) {
-  const auto r = runRastray({"explain", scene("three-triangles"), "40", "40", "--size", "80", "80", "--spp", "4"});
+  const auto r =
+      runRastray({"explain", scene("three-triangles"), "40", "40", "--size", "80", "80", "--spp", "4"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("== hits per sample"), std::string::npos);
   EXPECT_NE(r.out.find("== rasterizer"), std::string::npos);

@@ -70,7 +70,8 @@ std::vector<std::string> realWorldFiles() {
 INSTANTIATE_TEST_SUITE_P(Files, RealWorldInfo, ::testing::ValuesIn(realWorldFiles()),
                          [](const ::testing::TestParamInfo<std::string>& param) {
                            std::string name;
-                           for (char c : param.param) name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           for (char c : param.param)
+                             name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
                            return name;
                          });
 

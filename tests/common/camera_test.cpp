@@ -55,13 +55,16 @@ TEST(Camera, PrimaryRayStartsOnTheNearPlane) {
   for (glm::dvec2 px : {glm::dvec2(0, 0), glm::dvec2(100, 50), glm::dvec2(199.5, 13.25)}) {
     const Ray r = cam.primaryRay(px);
     EXPECT_NEAR(glm::length(r.direction), 1.0, 1e-14);
-    const glm::dvec3 nearPoint = glm::dvec3(cam.viewFromWorld * glm::dvec4(r.origin + r.tNear * r.direction, 1.0));
-    const glm::dvec3 farPoint = glm::dvec3(cam.viewFromWorld * glm::dvec4(r.origin + r.tFar * r.direction, 1.0));
+    const glm::dvec3 nearPoint =
+        glm::dvec3(cam.viewFromWorld * glm::dvec4(r.origin + r.tNear * r.direction, 1.0));
+    const glm::dvec3 farPoint =
+        glm::dvec3(cam.viewFromWorld * glm::dvec4(r.origin + r.tFar * r.direction, 1.0));
     EXPECT_NEAR(-nearPoint.z, 0.5, 1e-12);
     EXPECT_NEAR(-farPoint.z, 10.0, 1e-9);
     EXPECT_NEAR(r.tNear * r.depthPerT, 0.5, 1e-12);
     // The ray projects back onto the image position it was made for.
-    const glm::dvec2 ndc(nearPoint.x / (-nearPoint.z * cam.ndcScale().x), nearPoint.y / (-nearPoint.z * cam.ndcScale().y));
+    const glm::dvec2 ndc(nearPoint.x / (-nearPoint.z * cam.ndcScale().x),
+                         nearPoint.y / (-nearPoint.z * cam.ndcScale().y));
     const glm::dvec2 back = cam.imageFromNdc(ndc);
     EXPECT_NEAR(back.x, px.x, 1e-9);
     EXPECT_NEAR(back.y, px.y, 1e-9);

@@ -74,7 +74,8 @@ TEST(Shading, PointLightFollowsTheInverseSquareLaw) {
 // A tracer that returns a constant radiance and records what it was asked.
 class ConstantTracer : public SecondaryRayTracer {
  public:
-  glm::vec3 radiance(const SurfacePoint&, const glm::dvec3& direction, RayKind kind, int, float) const override {
+  glm::vec3 radiance(const SurfacePoint&, const glm::dvec3& direction, RayKind kind, int,
+                     float) const override {
     last.push_back({kind, direction});
     return kind == RayKind::Reflection ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
   }

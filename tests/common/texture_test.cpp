@@ -98,12 +98,12 @@ TEST(Texture, WrapModes) {
     const TextureSet set(textureScene(4, 1, fill, s));
     return set.sample(0, {u, 0.5f}, none, TextureFilter::Nearest).r;
   };
-  EXPECT_FLOAT_EQ(red(repeat, 1.125f), srgbToLinear(0.0f));        // texel 0 again
-  EXPECT_FLOAT_EQ(red(repeat, -0.125f), srgbToLinear(1.0f));       // texel 3
-  EXPECT_FLOAT_EQ(red(clamp, 1.9f), srgbToLinear(1.0f));           // edge texel 3
-  EXPECT_FLOAT_EQ(red(clamp, -3.0f), srgbToLinear(0.0f));          // edge texel 0
-  EXPECT_FLOAT_EQ(red(mirror, 1.125f), srgbToLinear(1.0f));        // mirrored: texel 3
-  EXPECT_FLOAT_EQ(red(mirror, 1.875f), srgbToLinear(0.0f));        // mirrored: texel 0
+  EXPECT_FLOAT_EQ(red(repeat, 1.125f), srgbToLinear(0.0f));   // texel 0 again
+  EXPECT_FLOAT_EQ(red(repeat, -0.125f), srgbToLinear(1.0f));  // texel 3
+  EXPECT_FLOAT_EQ(red(clamp, 1.9f), srgbToLinear(1.0f));      // edge texel 3
+  EXPECT_FLOAT_EQ(red(clamp, -3.0f), srgbToLinear(0.0f));     // edge texel 0
+  EXPECT_FLOAT_EQ(red(mirror, 1.125f), srgbToLinear(1.0f));   // mirrored: texel 3
+  EXPECT_FLOAT_EQ(red(mirror, 1.875f), srgbToLinear(0.0f));   // mirrored: texel 0
 }
 
 TEST(Texture, BilinearInterpolatesBetweenTexelCentres) {
@@ -113,10 +113,13 @@ TEST(Texture, BilinearInterpolatesBetweenTexelCentres) {
   });
   TextureSampler clamp;
   clamp.wrapS = clamp.wrapT = 33071;
-  const TextureSet set(textureScene(2, 1, [](int x, int, uint8_t* p) {
-    p[0] = p[1] = p[2] = x == 0 ? 0 : 255;
-    p[3] = 255;
-  }, clamp));
+  const TextureSet set(textureScene(
+      2, 1,
+      [](int x, int, uint8_t* p) {
+        p[0] = p[1] = p[2] = x == 0 ? 0 : 255;
+        p[3] = 255;
+      },
+      clamp));
   // uv 0.5 is halfway between the two texel centres (0.25 and 0.75).
   EXPECT_NEAR(set.sample(0, {0.5f, 0.5f}, {}, TextureFilter::Bilinear).r, 0.5f, 1e-6f);
   EXPECT_NEAR(set.sample(0, {0.25f, 0.5f}, {}, TextureFilter::Bilinear).r, 0.0f, 1e-6f);
