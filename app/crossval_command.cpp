@@ -3,6 +3,7 @@
 // sample by sample and layer by layer, one summary row per scene.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -137,7 +138,11 @@ int runCrossval(CrossvalOptions& opt) {
             {{"raster", r.raster.seconds}, {"raytrace", r.raytrace.seconds}, {"hybrid", r.hybrid.seconds}}}});
     std::cout << nlohmann::json{{"scenes", j}, {"failures", failures}}.dump(2) << "\n";
   } else {
-    std::printf("%-22s %9s %4s %9s %9s %9s %7s %7s %7s %7s %7s %9s %8s %7s %9s %8s %8s %8s\n", "scene",
+    // The scene column is as wide as the longest file name.
+    int nameWidth = 5;
+    for (const CrossvalResult& r : results)
+      nameWidth = std::max(nameWidth, int(std::filesystem::path(r.scenePath).filename().string().size()));
+    std::printf("%-*s %9s %4s %9s %9s %9s %7s %7s %7s %7s %7s %9s %8s %7s %9s %8s %8s %8s\n", nameWidth, "scene",
                 "size", "spp", "samples", "layers", "agree%", "edge", "shared", "ztie", "plane", "genuine",
                 "max relZ", "RMS", "PSNR", "hybrid d", "raster s", "ray s", "hybrid s");
     for (const CrossvalResult& r : results) {
@@ -145,9 +150,9 @@ int runCrossval(CrossvalOptions& opt) {
       char size[32];
       std::snprintf(size, sizeof size, "%dx%d", r.camera.width, r.camera.height);
       std::printf(
-          "%-22s %9s %4d %9llu %9llu %9.4f %7llu %7llu %7llu %7llu %7llu %9.2e %8.2e %7.1f %9.2e %8.3f %8.3f "
+          "%-*s %9s %4d %9llu %9llu %9.4f %7llu %7llu %7llu %7llu %7llu %9.2e %8.2e %7.1f %9.2e %8.3f %8.3f "
           "%8.3f\n",
-          std::filesystem::path(r.scenePath).filename().string().c_str(), size, opt.settings.spp,
+          nameWidth, std::filesystem::path(r.scenePath).filename().string().c_str(), size, opt.settings.spp,
           (unsigned long long)v.samples.compared, (unsigned long long)v.layers.compared,
           100.0 * v.layers.agreement(), (unsigned long long)v.layers.count(MismatchClass::SilhouetteEdge),
           (unsigned long long)v.layers.count(MismatchClass::SharedEdgeTie),
