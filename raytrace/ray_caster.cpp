@@ -317,7 +317,9 @@ struct RayCaster::Impl {
   }
 
   // Traces one ray (single-ray path) and gathers its layers.
-  void traceRadiance(HitGather& g, bool coherent, std::vector<Layer>* layers) const {
+  // One single-ray traversal of g.ray (filters gather BLEND hits into g);
+  // returns the closest accepted hit (instance kNoId when none).
+  GatheredHit intersectSingle(HitGather& g, bool coherent) const {
     const glm::vec3 origin(g.ray.origin), direction(g.ray.direction);
     RTCRayHit rh = makeRayHit(origin, direction, float(g.ray.tNear), float(g.ray.tFar), 0);
     GatherContext context;
@@ -337,7 +339,12 @@ struct RayCaster::Impl {
       closest.u = rh.hit.u;
       closest.v = rh.hit.v;
     }
-    collectLayers(g, origin, closest, layers);
+    return closest;
+  }
+
+  void traceRadiance(HitGather& g, bool coherent, std::vector<Layer>* layers) const {
+    const GatheredHit closest = intersectSingle(g, coherent);
+    collectLayers(g, glm::vec3(g.ray.origin), closest, layers);
   }
 
   // Front-to-back compositing of a ray's layers with premultiplied `over`
@@ -428,24 +435,7 @@ struct RayCaster::Impl {
     setupPrimary(g, pixel, position);
     count(RayKind::Primary);
     if (tTrace) traceStart = tTrace->size();
-    const glm::vec3 origin(g.ray.origin), direction(g.ray.direction);
-    RTCRayHit rh = makeRayHit(origin, direction, float(g.ray.tNear), float(g.ray.tFar), 0);
-    GatherContext context;
-    rtcInitIntersectContext(&context.embree);
-    context.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    context.gathers = &g;
-    {
-      FlushDenormalsScope ftz;
-      rtcIntersect1(embree->handle(), &context.embree, &rh);
-    }
-    GatheredHit closest;
-    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-      closest.t = rh.ray.tfar;
-      closest.instance = rh.hit.geomID;
-      closest.triangle = rh.hit.primID;
-      closest.u = rh.hit.u;
-      closest.v = rh.hit.v;
-    }
+    const GatheredHit closest = intersectSingle(g, /*coherent=*/true);
     return resolvePrimary(g, closest, sampleIndex, deep, layers);
   }
 
