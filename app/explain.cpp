@@ -84,22 +84,17 @@ std::string explainPixel(const Scene& scene, const RenderSettings& settings, int
 
   std::string out;
   char line[512];
-  s.renderer = RendererKind::Raster;
-  RenderRun raster;
-  std::string rasterTrace;
-  {
+  // Renders with one renderer while its trace of the pixel is captured.
+  auto renderTraced = [&](RendererKind kind, std::string* trace) {
+    s.renderer = kind;
     StderrCapture capture;
-    raster = renderScene(scene, s);
-    rasterTrace = capture.finish();
-  }
-  s.renderer = RendererKind::Raytrace;
-  RenderRun ray;
-  std::string rayTrace;
-  {
-    StderrCapture capture;
-    ray = renderScene(scene, s);
-    rayTrace = capture.finish();
-  }
+    RenderRun run = renderScene(scene, s);
+    *trace = capture.finish();
+    return run;
+  };
+  std::string rasterTrace, rayTrace;
+  const RenderRun raster = renderTraced(RendererKind::Raster, &rasterTrace);
+  const RenderRun ray = renderTraced(RendererKind::Raytrace, &rayTrace);
 
   std::snprintf(line, sizeof line, "pixel (%d, %d) of %s, %dx%d, %d spp\ncamera %s\n\n", x, y,
                 scene.path.c_str(), raster.camera.width, raster.camera.height, s.spp,
