@@ -45,6 +45,10 @@ struct DeepSample {
   float depth = 0.0f;     // view depth
   uint32_t instance = 0, triangle = 0;
   uint32_t sample = 0;  // index in the SPEC §3 sample pattern
+  // The renderer stopped after this layer (a transmittance cut-off or a
+  // layer limit) and did not look for the surfaces behind it (SPEC §6):
+  // another renderer's layers there are "cut off", not mismatches.
+  bool cutOff = false;
 };
 
 // Deep frame: pixel i owns samples[offsets[i], offsets[i + 1]), sorted by

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/analysis.h"
+#include "common/cull.h"
 #include "common/camera.h"
 #include "common/hit.h"
 #include "common/render_output.h"
@@ -17,7 +18,6 @@
 
 namespace rastray {
 
-enum class CullMode { None, Back, Front };                          // applies to single-sided materials only
 enum class DepthFormat { FloatReversed, Float, Unorm24, Unorm16 };  // precision: depth.h
 // Equal depths are decided by (instance, triangle) as if submitted in that
 // order: Less keeps the lower id, LEqual lets the higher win (depth.h).
