@@ -36,7 +36,7 @@ MaterialCounts countMaterials(const Scene& scene) {
     c.reflective += m.isReflective();
     c.refractive += m.isRefractive();
     c.emissive += m.isEmissive();
-    c.textured += m.baseColorTexture >= 0;
+    c.textured += m.baseColorTexture >= 0 || m.emissiveTexture >= 0;
     c.doubleSided += m.doubleSided;
   }
   return c;
@@ -87,6 +87,12 @@ int runInfo(const InfoOptions& opt) {
                    {"point", lightsByType[0]},
                    {"spot", lightsByType[1]},
                    {"directional", lightsByType[2]}};
+    // What the file uses and nothing renders (empty when nothing is ignored).
+    nlohmann::json ignored = nlohmann::json::array();
+    for (const IgnoredFeature& f : scene.ignored)
+      ignored.push_back(
+          {{"feature", f.feature}, {"unit", f.unit}, {"count", f.count}, {"text", f.describe()}});
+    j["ignored"] = ignored;
     j["cameras"] = scene.stats.cameras;
     j["cameraNodes"] = scene.stats.cameraNodes;
     if (scene.bounds.empty())
@@ -122,7 +128,8 @@ int runInfo(const InfoOptions& opt) {
                       {"vertices", in.vertexCount},
                       {"degenerate", in.degenerateCount},
                       {"mirrored", in.mirrored},
-                      {"normals", in.normals == NormalSource::Authored ? "authored" : "flat"}});
+                      {"normals", in.normals == NormalSource::Authored ? "authored" : "flat"},
+                      {"vertexColors", in.hasColors}});
     }
     j["instanceList"] = inst;
     std::cout << j.dump(2) << "\n";
@@ -154,6 +161,11 @@ int runInfo(const InfoOptions& opt) {
     std::printf("bounds     (%.6g, %.6g, %.6g) .. (%.6g, %.6g, %.6g)\n", scene.bounds.lo.x, scene.bounds.lo.y,
                 scene.bounds.lo.z, scene.bounds.hi.x, scene.bounds.hi.y, scene.bounds.hi.z);
   std::printf("camera     %dx%d %s\n", camera.width, camera.height, camera.describe().c_str());
+  if (!scene.ignored.empty()) {
+    std::string list;
+    for (const IgnoredFeature& f : scene.ignored) list += (list.empty() ? "" : "; ") + f.describe();
+    std::printf("ignored    %s\n", list.c_str());
+  }
   std::printf("\nwork the scene needs (SPEC 8):\n");
   for (const WorkDecision& d : analysis.decisions)
     std::printf("  %-9s %-18s %s\n", d.needed ? "needed" : "left out", toString(d.work), d.reason.c_str());

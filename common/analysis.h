@@ -17,7 +17,7 @@ enum class Work {
   Shadows,           // punctual lights: shadow rays or shadow maps
   ReflectionRays,    // mirror-reflective materials
   RefractionRays,    // transmissive dielectrics
-  Textures,          // base colour textures: decoding and mip chains
+  Textures,          // base colour and emissive textures: decoding and mip chains
 };
 
 const char* toString(Work work);

@@ -65,6 +65,9 @@ struct Material {
   float metallic = 1.0f;
   float roughness = 1.0f;
   glm::vec3 emissive{0.0f};  // emissiveFactor × KHR_materials_emissive_strength
+  // Multiplies `emissive` (sRGB-decoded RGB); read through the same uv set
+  // as the base colour texture (Scene::texcoords). -1: none.
+  int32_t emissiveTexture = -1;
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;
   bool doubleSided = false;
@@ -135,9 +138,19 @@ struct Instance {
   bool mirrored = false;  // det(worldFromObject) < 0: winding was swapped
   NormalSource normals = NormalSource::Flat;
   bool hasTexcoords = false;  // false: texcoords are all (0, 0)
+  bool hasColors = false;     // COLOR_0 read into Scene::colors; false: white
   uint32_t firstVertex = 0, vertexCount = 0;
   uint32_t firstTriangle = 0, triangleCount = 0;
   uint32_t degenerateCount = 0;  // zero-area triangles (kept, cover nothing)
+};
+
+// A feature the file uses that the loader checks but nothing renders, with
+// how often it occurs: "occlusion texture on 3 materials".
+struct IgnoredFeature {
+  std::string feature;  // e.g. "occlusion texture", "KHR_texture_transform"
+  std::string unit;     // singular: "material", "textureInfo", "primitive", ...
+  uint32_t count = 0;
+  std::string describe() const;  // "<feature> on <count> <unit>(s)"
 };
 
 // Counts of what the file holds, for `rastray info`.
@@ -156,8 +169,12 @@ struct Scene {
 
   // The triangle store (see the conventions above).
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;     // unit; (0,0,0) where NormalSource::Flat
-  std::vector<glm::vec2> texcoords;   // the set the base colour texture reads
+  std::vector<glm::vec3> normals;    // unit; (0,0,0) where NormalSource::Flat
+  std::vector<glm::vec2> texcoords;  // the set the base colour texture reads
+  // COLOR_0 as linear straight RGBA (vec3 colours get alpha 1); empty when
+  // no instance has COLOR_0, else parallel to positions and white where an
+  // instance has none.
+  std::vector<glm::vec4> colors;
   std::vector<glm::uvec3> triangles;  // absolute indices into the vertex arrays
   std::vector<Instance> instances;
 
@@ -169,6 +186,9 @@ struct Scene {
 
   Bounds bounds;  // world bounds of all instance vertices
   SceneFileStats stats;
+  // What the file uses and no renderer draws, in the order first met;
+  // empty when nothing is ignored.
+  std::vector<IgnoredFeature> ignored;
 
   const Instance& instanceOf(uint32_t instance) const { return instances[instance]; }
   // Stored vertex indices of (instance, triangle).

@@ -211,6 +211,15 @@ class SceneBuilder {
   void addLight(size_t node, const glm::dmat4& world);
   void loadMaterials();
   void loadTextures();
+  // Records one more occurrence of a feature nothing renders (Scene::ignored).
+  void noteIgnored(const std::string& feature, const std::string& unit);
+  void noteIgnoredFeatures();
+  void noteIgnoredExtensions(const json& value, std::vector<std::string>& path);
+  // The texture a textureInfo names, or -1 when its texture has no image
+  // we could decode (e.g. only a KTX2 source through an extension).
+  int32_t decodableTexture(const json& textureInfo);
+  std::vector<glm::vec4> readColors(const json& attributes, const std::string& element,
+                                    size_t vertexCount) const;
 
   // Reads accessor `index` as doubles (components × count), applying
   // normalisation and sparse substitution. Ranges were checked before.
@@ -514,7 +523,9 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
                   std::to_string(vertexCount));
     inst.normals = NormalSource::Authored;
   }
-  // The texcoord set the base colour texture reads (TEXCOORD_0 unless it says otherwise).
+  // The texcoord set the base colour texture reads (TEXCOORD_0 unless it
+  // says otherwise); without one, the emissive texture's set. loadMaterials
+  // drops an emissive texture that names another set than the base colour.
   int64_t texCoordSet = 0;
   {
     const json& mats = array("materials");
@@ -522,6 +533,8 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
       const json& m = mats[prim.at("material").get<size_t>()];
       if (m.contains("pbrMetallicRoughness") && m.at("pbrMetallicRoughness").contains("baseColorTexture"))
         texCoordSet = get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0);
+      else if (m.contains("emissiveTexture"))
+        texCoordSet = get<int64_t>(m.at("emissiveTexture"), "texCoord", 0);
     }
   }
   const std::string uvName = "TEXCOORD_" + std::to_string(texCoordSet);
@@ -532,6 +545,11 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
                   std::to_string(vertexCount));
     inst.hasTexcoords = true;
   }
+  const std::vector<glm::vec4> colors = readColors(attributes, e, vertexCount);
+  inst.hasColors = !colors.empty();
+  // Scene::colors stays empty until an instance has COLOR_0; then it is
+  // back-filled with white for the vertices before it.
+  if (inst.hasColors && scene_.colors.empty()) scene_.colors.assign(scene_.positions.size(), glm::vec4(1.0f));
 
   // Normals transform by the cofactor matrix: the inverse transpose scaled
   // by the determinant, defined even for singular matrices; the sign keeps
@@ -558,6 +576,8 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
     scene_.normals.emplace_back(n);
     scene_.texcoords.emplace_back(uv.empty() ? glm::vec2(0.0f)
                                              : glm::vec2(float(uv[2 * v]), float(uv[2 * v + 1])));
+    if (inst.hasColors || !scene_.colors.empty())
+      scene_.colors.push_back(inst.hasColors ? colors[v] : glm::vec4(1.0f));
   }
   inst.vertexCount = uint32_t(vertexCount);
 
@@ -732,12 +752,10 @@ void SceneBuilder::loadMaterials() {
         mat.baseColorFactor = glm::vec4(unit(f[0], "baseColorFactor"), unit(f[1], "baseColorFactor"),
                                         unit(f[2], "baseColorFactor"), unit(f[3], "baseColorFactor"));
       }
-      if (pbr.contains("baseColorTexture")) {
-        const int32_t tex = pbr.at("baseColorTexture").at("index").get<int32_t>();
-        // A texture without an image we can decode (e.g. only a KTX2 source
-        // through an extension) is ignored: the factor alone applies.
-        if (scene_.textures[size_t(tex)].image >= 0) mat.baseColorTexture = tex;
-      }
+      // A texture without an image we can decode is ignored (and listed):
+      // the factor alone applies.
+      if (pbr.contains("baseColorTexture"))
+        mat.baseColorTexture = decodableTexture(pbr.at("baseColorTexture"));
       mat.metallic = unit(get(pbr, "metallicFactor", 1.0), "metallicFactor");
       mat.roughness = unit(get(pbr, "roughnessFactor", 1.0), "roughnessFactor");
     }
@@ -746,6 +764,19 @@ void SceneBuilder::loadMaterials() {
       const auto f = m.at("emissiveFactor").get<std::vector<double>>();
       emissive = glm::dvec3(unit(f[0], "emissiveFactor"), unit(f[1], "emissiveFactor"),
                             unit(f[2], "emissiveFactor"));
+    }
+    if (m.contains("emissiveTexture")) {
+      // One uv set per vertex (Scene::texcoords): the emissive texture must
+      // read the base colour texture's set, or it is listed as ignored.
+      const json& info = m.at("emissiveTexture");
+      const bool sameSet = !m.contains("pbrMetallicRoughness") ||
+                           !m.at("pbrMetallicRoughness").contains("baseColorTexture") ||
+                           get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0) ==
+                               get<int64_t>(info, "texCoord", 0);
+      if (sameSet)
+        mat.emissiveTexture = decodableTexture(info);
+      else
+        noteIgnored("emissive texture on another texCoord set than the base colour texture", "material");
     }
     const std::string mode = get<std::string>(m, "alphaMode", "OPAQUE");
     mat.alphaMode = mode == "MASK" ? AlphaMode::Mask : mode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
@@ -773,6 +804,110 @@ void SceneBuilder::loadMaterials() {
   }
 }
 
+int32_t SceneBuilder::decodableTexture(const json& textureInfo) {
+  const int32_t tex = textureInfo.at("index").get<int32_t>();
+  if (scene_.textures[size_t(tex)].image >= 0) return tex;
+  noteIgnored("texture without a decodable image", "textureInfo");
+  return -1;
+}
+
+// COLOR_0 (glTF 2.0 §3.7.2.1): VEC3 or VEC4, float or normalized unsigned
+// byte/short, linear. Empty when the primitive has none.
+std::vector<glm::vec4> SceneBuilder::readColors(const json& attributes, const std::string& element,
+                                                size_t vertexCount) const {
+  if (!attributes.contains("COLOR_0")) return {};
+  const int64_t index = attributes.at("COLOR_0").get<int64_t>();
+  const json& a = array("accessors")[size_t(index)];
+  const std::string e = element + " COLOR_0";
+  const int64_t ct = a.at("componentType").get<int64_t>();
+  if (!(ct == 5126 || ((ct == 5121 || ct == 5123) && get(a, "normalized", false))))
+    fail(e + " (accessor " + std::to_string(index) + ")",
+         "componentType " + std::to_string(ct) + " must be 5126, or 5121 or 5123 with \"normalized\": true");
+  size_t components = 0;
+  const std::vector<double> c = readAccessor(index, e, {"VEC3", "VEC4"}, &components);
+  if (c.size() / components != vertexCount)
+    fail(element, "COLOR_0 has " + std::to_string(c.size() / components) + " elements, POSITION " +
+                      std::to_string(vertexCount));
+  std::vector<glm::vec4> out(vertexCount, glm::vec4(1.0f));
+  for (size_t v = 0; v < vertexCount; ++v)
+    for (size_t k = 0; k < components; ++k)
+      out[v][int(k)] = float(std::clamp(c[v * components + k], 0.0, 1.0));  // float colours may stray
+  return out;
+}
+
+void SceneBuilder::noteIgnored(const std::string& feature, const std::string& unit) {
+  for (IgnoredFeature& f : scene_.ignored)
+    if (f.feature == feature && f.unit == unit) {
+      ++f.count;
+      return;
+    }
+  scene_.ignored.push_back({feature, unit, 1});
+}
+
+// What the checker accepted and nothing renders. Counted over the file's
+// elements (every material, primitive, node), used or not.
+void SceneBuilder::noteIgnoredFeatures() {
+  for (const json& m : array("materials")) {
+    if (m.contains("normalTexture")) noteIgnored("normal texture", "material");
+    if (m.contains("occlusionTexture")) noteIgnored("occlusion texture", "material");
+    if (m.contains("pbrMetallicRoughness") &&
+        m.at("pbrMetallicRoughness").contains("metallicRoughnessTexture"))
+      noteIgnored("metallicRoughness texture", "material");
+    if (m.contains("extensions") && m.at("extensions").contains("KHR_materials_transmission") &&
+        m.at("extensions").at("KHR_materials_transmission").contains("transmissionTexture"))
+      noteIgnored("transmission texture", "material");
+  }
+  for (const json& mesh : array("meshes"))
+    for (const json& prim : mesh.at("primitives")) {
+      if (prim.contains("targets")) noteIgnored("morph targets", "primitive");
+      for (auto it = prim.at("attributes").begin(); it != prim.at("attributes").end(); ++it)
+        if (it.key().rfind("JOINTS_", 0) == 0) {
+          noteIgnored("skinning attributes (JOINTS_n/WEIGHTS_n)", "primitive");
+          break;
+        }
+    }
+  for (const json& n : array("nodes"))
+    if (n.contains("skin")) noteIgnored("skin", "node");
+  for (size_t i = 0; i < array("animations").size(); ++i) noteIgnored("animation", "");
+  std::vector<std::string> path;
+  noteIgnoredExtensions(doc_, path);
+}
+
+// Every extension object in the document whose extension is not supported
+// (KHR_texture_transform, KHR_materials_volume, ...), counted by the kind
+// of element that holds it.
+void SceneBuilder::noteIgnoredExtensions(const json& value, std::vector<std::string>& path) {
+  if (value.is_array()) {
+    for (size_t i = 0; i < value.size(); ++i) {
+      path.push_back("#");  // an array entry: its index does not name the kind
+      noteIgnoredExtensions(value[i], path);
+      path.pop_back();
+    }
+    return;
+  }
+  if (!value.is_object()) return;
+  if (value.contains("extensions") && value.at("extensions").is_object()) {
+    std::string unit = "root object";
+    const size_t n = path.size();
+    if (n >= 1 && path[n - 1].size() > 7 && path[n - 1].compare(path[n - 1].size() - 7, 7, "Texture") == 0)
+      unit = "textureInfo";
+    else if (n == 4 && path[0] == "meshes" && path[2] == "primitives")
+      unit = "primitive";
+    else if (n == 2 && path[1] == "#" && !singular(path[0]).empty())
+      unit = singular(path[0]);
+    else if (n >= 1)
+      unit = path[n - 1] == "#" && n >= 2 ? path[n - 2] + " entry" : "\"" + path[n - 1] + "\"";
+    for (auto it = value.at("extensions").begin(); it != value.at("extensions").end(); ++it)
+      if (!isSupportedExtension(it.key())) noteIgnored(it.key(), unit);
+  }
+  for (auto it = value.begin(); it != value.end(); ++it) {
+    if (it.key() == "extras") continue;  // application data, not glTF
+    path.push_back(it.key());
+    noteIgnoredExtensions(it.value(), path);
+    path.pop_back();
+  }
+}
+
 Scene SceneBuilder::build() {
   scene_.path = path_;
   scene_.stats.nodes = uint32_t(array("nodes").size());
@@ -783,6 +918,7 @@ Scene SceneBuilder::build() {
   std::vector<int64_t> parent;
   checkNodeGraph(parent);
   walk(rootNodes(parent));
+  noteIgnoredFeatures();
   return std::move(scene_);
 }
 
@@ -911,6 +1047,12 @@ glm::dvec3 faceNormal(const Scene& scene, uint32_t instance, uint32_t tri) {
   const glm::uvec3 t = scene.triangle(instance, tri);
   const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
   return glm::cross(b - a, c - a);
+}
+
+std::string IgnoredFeature::describe() const {
+  const std::string plural = count == 1 ? "" : "s";
+  if (unit.empty()) return std::to_string(count) + " " + feature + plural;
+  return feature + " on " + std::to_string(count) + " " + unit + plural;
 }
 
 const char* toString(AlphaMode mode) {

@@ -42,7 +42,14 @@ glm::vec4 Shader::baseColor(const SurfacePoint& p, const TextureFootprint& footp
   glm::vec4 c = p.material->baseColorFactor;
   if (p.material->baseColorTexture >= 0 && !textures_.empty())
     c *= textures_.sample(p.material->baseColorTexture, p.uv, footprint, options_.textureFilter);
-  return c;
+  return c * p.color;  // glTF: factor × texture × COLOR_0
+}
+
+glm::vec3 Shader::emission(const SurfacePoint& p, const TextureFootprint& footprint) const {
+  glm::vec3 e = p.material->emissive;
+  if (p.material->emissiveTexture >= 0 && !textures_.empty() && e != glm::vec3(0.0f))
+    e *= glm::vec3(textures_.sample(p.material->emissiveTexture, p.uv, footprint, options_.textureFilter));
+  return e;
 }
 
 float Shader::coverageAlpha(const SurfacePoint& p, const TextureFootprint& footprint) const {
@@ -117,7 +124,7 @@ glm::vec4 Shader::shade(const SurfacePoint& p, const glm::dvec3& direction, cons
 
   const float w = m.mirrorWeight();
   const float t = m.transmission;
-  glm::vec3 L = m.emissive;
+  glm::vec3 L = emission(p, footprint);
   const float diffuseWeight = (1.0f - w) * (1.0f - t);
   if (diffuseWeight > 0.0f) L += diffuseWeight * directLight(p, n, direction, c);
 

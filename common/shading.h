@@ -1,8 +1,9 @@
 // The one shading model both renderers use (SPEC §5).
 //
 // For a surface point seen along direction d, with base colour C (factor ×
-// sRGB-decoded texture), mirror weight w = metallic·(1 − roughness) and
-// transmission t, the outgoing radiance is
+// sRGB-decoded texture × interpolated COLOR_0), emissive = emissive factor
+// × strength × sRGB-decoded emissive texture, mirror weight
+// w = metallic·(1 − roughness) and transmission t, the outgoing radiance is
 //
 //   L = emissive + (1 − w)(1 − t) · C/π · Σ_lights E_l · V_l · max(0, n·l)
 //       + w · C · L_reflect
@@ -77,8 +78,11 @@ class Shader {
          const ShadingOptions& options, const LightVisibility* visibility,
          const SecondaryRayTracer* secondary);
 
-  // Straight linear RGBA base colour (factor × texture) at a point.
+  // Straight linear RGBA base colour (factor × texture × COLOR_0) at a point.
   glm::vec4 baseColor(const SurfacePoint& point, const TextureFootprint& footprint) const;
+  // Emitted linear RGB (emissive × emissive texture) at a point; the
+  // texture is filtered through the same footprint as the base colour's.
+  glm::vec3 emission(const SurfacePoint& point, const TextureFootprint& footprint) const;
   // The alpha a renderer uses for MASK and BLEND coverage decisions.
   float coverageAlpha(const SurfacePoint& point, const TextureFootprint& footprint) const;
 

@@ -45,6 +45,8 @@ SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit) {
   }
   if (inst.hasTexcoords)
     sp.uv = float(b0) * scene.texcoords[t.x] + hit.b1 * scene.texcoords[t.y] + hit.b2 * scene.texcoords[t.z];
+  if (inst.hasColors)
+    sp.color = float(b0) * scene.colors[t.x] + hit.b1 * scene.colors[t.y] + hit.b2 * scene.colors[t.z];
   return sp;
 }
 

@@ -23,6 +23,10 @@ struct SurfacePoint {
   glm::dvec3 geometricNormal{0.0, 0.0, 1.0};  // unit; the CCW (front) side
   glm::dvec3 shadingNormal{0.0, 0.0, 1.0};    // unit; authored and interpolated, else geometric
   glm::vec2 uv{0.0f};
+  // COLOR_0 interpolated with the barycentrics: linear straight RGBA,
+  // white where the instance has none. Shading multiplies it into the
+  // base colour (glTF: factor × texture × COLOR_0).
+  glm::vec4 color{1.0f};
 };
 
 SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit);

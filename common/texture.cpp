@@ -103,15 +103,18 @@ glm::vec4 unpremultiply(const glm::vec4& c) {
 TextureSet::TextureSet(const Scene& scene) {
   chains_.resize(scene.textures.size());
   samplers_.resize(scene.textures.size());
-  for (const Material& m : scene.materials) {
-    if (m.baseColorTexture < 0) continue;
-    const size_t t = size_t(m.baseColorTexture);
-    samplers_[t] = scene.textures[t].sampler;
-    if (!chains_[t].empty()) continue;
-    std::vector<MipLevel>& chain = chains_[t];
-    chain.push_back(decodeLevel0(scene.images[size_t(scene.textures[t].image)]));
-    while (chain.back().width > 1 || chain.back().height > 1) chain.push_back(halve(chain.back()));
-  }
+  // Base colour and emissive textures are both sRGB colour: one chain
+  // serves a texture used as either.
+  for (const Material& m : scene.materials)
+    for (const int32_t texture : {m.baseColorTexture, m.emissiveTexture}) {
+      if (texture < 0) continue;
+      const size_t t = size_t(texture);
+      samplers_[t] = scene.textures[t].sampler;
+      if (!chains_[t].empty()) continue;
+      std::vector<MipLevel>& chain = chains_[t];
+      chain.push_back(decodeLevel0(scene.images[size_t(scene.textures[t].image)]));
+      while (chain.back().width > 1 || chain.back().height > 1) chain.push_back(halve(chain.back()));
+    }
 }
 
 size_t TextureSet::levelCount(int texture) const { return chains_[size_t(texture)].size(); }

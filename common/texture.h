@@ -1,5 +1,5 @@
-// Base colour textures: sRGB decoding, mip chains and filtered lookups,
-// shared by both renderers.
+// Base colour and emissive textures: sRGB decoding, mip chains and
+// filtered lookups, shared by both renderers.
 //
 // Mip chains are built in linear, premultiplied float RGBA (so filtering
 // neither darkens nor fringes at alpha edges: the premultiplied-alpha

@@ -110,9 +110,10 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         CoverageScratch scratch;
         for (uint32_t index : transmissiveBins[size_t(tile)]) {
           const TriangleSetup& t = setups[index];
-          // Untextured: the transmittance is the material's, the same everywhere.
+          // Untextured, without vertex colours: the transmittance is the
+          // material's, the same everywhere.
           const Material& m = scene.materialOf(t.instance);
-          const bool constant = m.baseColorTexture < 0;
+          const bool constant = m.baseColorTexture < 0 && !scene.instanceOf(t.instance).hasColors;
           SurfacePoint any;
           any.material = &m;
           const glm::vec3 uniform = constant ? shader->shadowTransmittance(any) : glm::vec3(1.0f);

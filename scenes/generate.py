@@ -20,10 +20,10 @@ import zlib
 HERE = os.path.dirname(os.path.abspath(__file__))
 GENERATOR = "rastray scenes/generate.py"
 
-FLOAT, USHORT, UINT = 5126, 5123, 5125
+FLOAT, UBYTE, USHORT, UINT = 5126, 5121, 5123, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 TRIANGLES = 4
-LINEAR, LINEAR_MIPMAP_LINEAR, REPEAT = 9729, 9987, 10497
+NEAREST, LINEAR, LINEAR_MIPMAP_LINEAR, REPEAT, CLAMP_TO_EDGE = 9728, 9729, 9987, 10497, 33071
 COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
 COMPONENT_SIZE = {5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4}
 
@@ -193,14 +193,17 @@ class Gltf:
         self.doc["bufferViews"].append(view)
         return len(self.doc["bufferViews"]) - 1
 
-    def accessor(self, values, type_, component=FLOAT, target=ARRAY_BUFFER, bounds=False):
-        """values: list of tuples (VECn) or ints (SCALAR). Returns the accessor index."""
+    def accessor(self, values, type_, component=FLOAT, target=ARRAY_BUFFER, bounds=False, normalized=False):
+        """values: list of tuples (VECn) or ints (SCALAR). Returns the accessor index.
+        Integer components are stored as given (normalized: the reader divides)."""
         n = COMPONENTS[type_]
         flat = [v for t in values for v in t] if n > 1 else list(values)
-        fmt = {FLOAT: "f", USHORT: "H", UINT: "I"}[component]
+        fmt = {FLOAT: "f", UBYTE: "B", USHORT: "H", UINT: "I"}[component]
         payload = struct.pack("<%d%s" % (len(flat), fmt), *flat)
         acc = {"bufferView": self._view(payload, target), "componentType": component,
                "count": len(values), "type": type_}
+        if normalized:
+            acc["normalized"] = True
         if bounds:
             cols = [[f32(t[k]) for t in values] for k in range(n)]
             acc["min"] = [min(c) for c in cols]
@@ -332,8 +335,8 @@ THREE_TRIANGLES = [
 
 def three_triangles():
     """The textbook z-buffer example: three opaque triangles at view depths
-    0.25 (red), 0.5 (yellow), 0.75 (blue), submitted in the lecture's order
-    (yellow, blue, red), so submission order is not depth order."""
+    0.25 (red), 0.5 (yellow), 0.75 (blue), submitted in the order yellow,
+    blue, red, so submission order is not depth order."""
     g = Gltf()
     for name, color, depth, verts in THREE_TRIANGLES:
         geom = Geometry()
@@ -515,6 +518,61 @@ def textured_plane():
     return g.finish()
 
 
+# vertex-colors: four 0.8×0.8 quads at z = −1 seen by an orthographic
+# camera (xmag = ymag = 1), no lights, so a pixel shows its base colour (or
+# emission) directly. (u, v) run 0..1 across each quad, left to right and
+# bottom to top; every COLOR_0 is a linear function of (u, v), which
+# barycentric interpolation reproduces exactly on any triangulation.
+VC_QUADS = [
+    # name, lower-left corner (x, y), COLOR_0 (u, v) -> RGBA, component type
+    ("FloatRGB", (-0.9, 0.1), lambda u, v: (u, v, 1 - u), FLOAT),
+    ("ByteRGBA", (0.1, 0.1), lambda u, v: (u, v, 1 - u, 1), UBYTE),
+    ("ShortMask", (-0.9, -0.9), lambda u, v: (1, 1, 0, u), USHORT),
+    ("Emissive", (0.1, -0.9), None, None),
+]
+VC_SIZE = 0.8
+# The emissive texture: 2×2 texels, row 0 (top) red, green; row 1 blue, white.
+VC_TEXELS = [[(255, 0, 0), (0, 255, 0)], [(0, 0, 255), (255, 255, 255)]]
+
+
+def vertex_colors():
+    """COLOR_0 in the three allowed component types (float VEC3, normalized
+    unsigned byte and short VEC4, the short one driving MASK coverage by its
+    alpha) and an emissive texture on a black base colour."""
+    g = Gltf()
+    tex = g.texture(png_rgb(2, 2, lambda x, y: VC_TEXELS[y][x]), "emissive-2x2",
+                    {"magFilter": NEAREST, "minFilter": NEAREST, "wrapS": CLAMP_TO_EDGE, "wrapT": CLAMP_TO_EDGE})
+    scale = {FLOAT: 1.0, UBYTE: 255, USHORT: 65535}
+    for name, (x0, y0), color, component in VC_QUADS:
+        geom = Geometry()
+        corners = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        for u, v in corners:
+            geom.vertex((x0 + VC_SIZE * u, y0 + VC_SIZE * v, -1.0), (0.0, 0.0, 1.0), (u, 1 - v))
+        geom.triangles += [(0, 1, 2), (0, 2, 3)]
+        if name == "FloatRGB":
+            mat = g.material(name, (1, 1, 1, 1))
+        elif name == "ByteRGBA":
+            mat = g.material(name, (1, 0.5, 1, 1))
+        elif name == "ShortMask":
+            mat = g.material(name, (1, 1, 1, 1), alpha_mode="MASK")
+            g.doc["materials"][mat]["alphaCutoff"] = 0.5
+        else:
+            mat = g.material(name, (0, 0, 0, 1))
+            g.doc["materials"][mat].update({"emissiveFactor": [1.0, 1.0, 1.0], "emissiveTexture": {"index": tex}})
+        prim = g.primitive(geom, mat)
+        if color is not None:
+            values = [tuple(round(c * scale[component]) if component != FLOAT else float(c) for c in color(u, v))
+                      for u, v in corners]
+            prim["attributes"]["COLOR_0"] = g.accessor(values, "VEC%d" % len(values[0]), component,
+                                                       normalized=component != FLOAT)
+        g.doc["meshes"].append({"name": name, "primitives": [prim]})
+        g.node(name, mesh=len(g.doc["meshes"]) - 1)
+    g.doc["cameras"].append({"name": "Ortho", "type": "orthographic",
+                             "orthographic": {"xmag": 1.0, "ymag": 1.0, "znear": 0.125, "zfar": 2.0}})
+    g.node("Ortho", camera=0)
+    return g.finish()
+
+
 SCENES = [
     ("three-triangles.gltf", three_triangles),
     ("interpenetrating.gltf", interpenetrating),
@@ -522,6 +580,7 @@ SCENES = [
     ("cornell-box.gltf", cornell_box),
     ("transparent-layers.gltf", transparent_layers),
     ("textured-plane.gltf", textured_plane),
+    ("vertex-colors.gltf", vertex_colors),
 ]
 
 
@@ -561,6 +620,9 @@ def read_accessor(doc, buffers, index, name=""):
     require(need <= vl, where, "runs past the end of bufferView %d" % view_index)
     fmt = "<%d%s" % (n, {5126: "f", 5123: "H", 5125: "I", 5121: "B"}[acc["componentType"]])
     out = [struct.unpack_from(fmt, buf, vo + ao + k * stride) for k in range(acc["count"])]
+    if acc.get("normalized"):
+        top = {5121: 255.0, 5123: 65535.0}[acc["componentType"]]
+        out = [tuple(c / top for c in v) for v in out]
     return [v[0] for v in out] if n == 1 else out
 
 
@@ -639,6 +701,27 @@ def check_cyclic(tris):
             "front-of relation is %s, not the cycle 0>1>2>0" % sorted(front))
 
 
+def check_vertex_colors(doc, buffers):
+    """Every COLOR_0 equals its quad's colour function at the vertex, in
+    the component type the table names; the emissive PNG holds VC_TEXELS."""
+    where = "vertex-colors.gltf"
+    for mesh, (name, (x0, y0), color, component) in zip(doc["meshes"], VC_QUADS):
+        attrs = mesh["primitives"][0]["attributes"]
+        require(("COLOR_0" in attrs) == (color is not None), where, "%s: COLOR_0 presence" % name)
+        if color is None:
+            continue
+        acc = doc["accessors"][attrs["COLOR_0"]]
+        require(acc["componentType"] == component and acc.get("normalized", False) == (component != FLOAT),
+                where, "%s: COLOR_0 component type" % name)
+        for p, c in zip(read_accessor(doc, buffers, attrs["POSITION"]),
+                        read_accessor(doc, buffers, attrs["COLOR_0"])):
+            want = color((p[0] - x0) / VC_SIZE, (p[1] - y0) / VC_SIZE)
+            require(all(abs(a - b) < 1e-6 for a, b in zip(c, want)) and len(c) == len(want), where,
+                    "%s: COLOR_0 %s at %s, want %s" % (name, c, p, want))
+    png = decode_data_uri(doc["images"][0]["uri"], where)
+    require(png == png_rgb(2, 2, lambda x, y: VC_TEXELS[y][x]), where, "emissive texture differs from VC_TEXELS")
+
+
 def check_file(path):
     name = os.path.basename(path)
     size = os.path.getsize(path)
@@ -714,6 +797,8 @@ def check_file(path):
                                [[(x, y, -d) for x, y in verts] for _, _, d, verts in THREE_TRIANGLES]])
     if name == "cyclic-overlap.gltf":
         check_cyclic(cyclic_sticks())
+    if name == "vertex-colors.gltf":
+        check_vertex_colors(doc, buffers)
     return size, counts
 
 
