@@ -122,10 +122,12 @@ glm::vec4 Shader::shade(const SurfacePoint& p, const glm::dvec3& direction, cons
   // fall back to the geometric one there, so no light leaks through.
   const glm::dvec3 n = glm::dot(facing, -direction) > 0.0 ? facing : facingGeometric;
 
+  // The weights partition unity (header): the mirror part w first, then the
+  // remaining dielectric (1 − w) splits into refraction and diffuse.
   const float w = m.mirrorWeight();
-  const float t = m.transmission;
+  const float t = (1.0f - w) * m.transmission;
   glm::vec3 L = emission(p, footprint);
-  const float diffuseWeight = (1.0f - w) * (1.0f - t);
+  const float diffuseWeight = (1.0f - w) * (1.0f - m.transmission);
   if (diffuseWeight > 0.0f) L += diffuseWeight * directLight(p, n, direction, c);
 
   const bool canTrace = secondary_ && depth < options_.maxDepth;

@@ -7,9 +7,16 @@
 //
 //   L = emissive + (1 − w)(1 − t) · C/π · Σ_lights E_l · V_l · max(0, n·l)
 //       + w · C · L_reflect
-//       + t · (F · L_reflect + (1 − F) · C · L_refract)
+//       + (1 − w) t · (F · L_reflect + (1 − F) · C · L_refract)
 //
-// with F the exact dielectric Fresnel reflectance (common/optics.h), E_l
+// The three weights (1 − w)(1 − t), w and (1 − w)t sum to exactly 1, so a
+// white surface in a white surround (a furnace) returns at most what
+// arrives: the mirror (metal) part w comes first, as metals do not
+// transmit, and the remaining dielectric part (1 − w) splits into
+// refraction t and diffuse 1 − t (glTF's mix of the metal and dielectric
+// lobes, with transmission inside the dielectric one).
+//
+// F is the exact dielectric Fresnel reflectance (common/optics.h), E_l
 // the light's irradiance (point and spot: intensity / distance², with
 // glTF's range window and spot cone falloff; directional: intensity) and
 // V_l the light's transmittance from the renderer (shadow rays or shadow
