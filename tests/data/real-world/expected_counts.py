@@ -38,6 +38,12 @@ Keys:
   sceneIndex         the scene walked, or -1 when the file has no scenes
   instanceList       per instance, in instance order: node, mesh, primitive,
                      mode, triangles
+  ignored            what the file uses and rastray does not render (README,
+                     "The scene model"), as {feature: count}: "animation",
+                     "skin" (nodes), "morph targets" (primitives), "normal
+                     texture", "occlusion texture", "metallicRoughness
+                     texture" (materials), and each extension not in
+                     SUPPORTED by the objects that hold it; {} when none
 
 Usage:
   python3 expected_counts.py          write expected.json
@@ -52,6 +58,38 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = os.path.join(HERE, "expected.json")
 
 TRIANGLES, STRIP, FAN = 4, 5, 6
+SUPPORTED = {"KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior",
+             "KHR_materials_emissive_strength", "KHR_mesh_quantization"}
+
+
+def ignored(doc):
+    out = {}
+
+    def note(feature, n=1):
+        if n:
+            out[feature] = out.get(feature, 0) + n
+
+    note("animation", len(doc.get("animations", [])))
+    note("skin", sum("skin" in n for n in doc.get("nodes", [])))
+    note("morph targets", sum("targets" in p for m in doc.get("meshes", []) for p in m["primitives"]))
+    for m in doc.get("materials", []):
+        note("normal texture", "normalTexture" in m)
+        note("occlusion texture", "occlusionTexture" in m)
+        note("metallicRoughness texture", "metallicRoughnessTexture" in m.get("pbrMetallicRoughness", {}))
+
+    def extensions(value):
+        if isinstance(value, list):
+            for v in value:
+                extensions(v)
+        elif isinstance(value, dict):
+            for name in value.get("extensions", {}) if isinstance(value.get("extensions"), dict) else {}:
+                note(name, name not in SUPPORTED)
+            for key, v in value.items():
+                if key != "extras":
+                    extensions(v)
+
+    extensions(doc)
+    return out
 
 
 def load_json(path):
@@ -111,7 +149,7 @@ def counts(doc):
         "lightDefinitions": len(doc.get("extensions", {})
                                 .get("KHR_lights_punctual", {}).get("lights", [])),
         "visitedNodes": 0, "meshes": len(meshes), "defaultMaterialUsed": False,
-        "sceneIndex": scene_index, "instanceList": [],
+        "sceneIndex": scene_index, "instanceList": [], "ignored": ignored(doc),
     }
     for ni in walk(doc, roots):
         node = nodes[ni]
