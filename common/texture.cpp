@@ -55,42 +55,45 @@ MipLevel halve(const MipLevel& src) {
   return dst;
 }
 
-int wrap(int i, int n, int mode) {
-  switch (mode) {
-    case 33071:
-      return std::clamp(i, 0, n - 1);  // CLAMP_TO_EDGE
-    case 33648: {                      // MIRRORED_REPEAT
-      const int period = 2 * n;
-      int m = i % period;
-      if (m < 0) m += period;
-      return m < n ? m : period - 1 - m;
-    }
-    default: {  // REPEAT
-      int m = i % n;
-      return m < 0 ? m + n : m;
-    }
+// The texel index in [0, n) along an axis of n texels for the integer
+// texel coordinate i (any double: huge, infinite or NaN), under a glTF
+// wrap mode. The wrap is done in double, where fmod is exact, and only its
+// result, already in [0, n), is converted to int: no conversion can
+// overflow, whatever the texture size or uv.
+int wrap(double i, int n, int mode) {
+  if (std::isnan(i)) i = 0.0;
+  if (mode == 33071) return int(std::clamp(i, 0.0, double(n - 1)));  // CLAMP_TO_EDGE
+  if (std::isinf(i)) i = 0.0;  // no period to follow: any texel is as good
+  if (mode == 33648) {         // MIRRORED_REPEAT
+    const double period = 2.0 * double(n);
+    double m = std::fmod(i, period);
+    if (m < 0.0) m += period;  // exact: m is an integer in (−period, 0)
+    return int(m < double(n) ? m : period - 1.0 - m);
   }
+  double m = std::fmod(i, double(n));  // REPEAT
+  if (m < 0.0) m += double(n);
+  return int(m);
 }
 
-glm::vec4 texel(const MipLevel& level, int x, int y, const TextureSampler& s) {
-  x = wrap(x, level.width, s.wrapS);
-  y = wrap(y, level.height, s.wrapT);
-  return level.texels[size_t(y) * size_t(level.width) + size_t(x)];
+glm::vec4 texel(const MipLevel& level, double x, double y, const TextureSampler& s) {
+  const int ix = wrap(x, level.width, s.wrapS);
+  const int iy = wrap(y, level.height, s.wrapT);
+  return level.texels[size_t(iy) * size_t(level.width) + size_t(ix)];
 }
 
 // Texel centres sit at half-integers: uv (0, 0) is the top-left corner of
-// texel (0, 0).
+// texel (0, 0). Texel coordinates are formed in double: float uv times any
+// int size stays finite there.
 glm::vec4 nearest(const MipLevel& level, glm::vec2 uv, const TextureSampler& s) {
-  return texel(level, int(std::floor(uv.x * level.width)), int(std::floor(uv.y * level.height)), s);
+  return texel(level, std::floor(double(uv.x) * level.width), std::floor(double(uv.y) * level.height), s);
 }
 
 glm::vec4 bilinear(const MipLevel& level, glm::vec2 uv, const TextureSampler& s) {
-  const float x = uv.x * level.width - 0.5f, y = uv.y * level.height - 0.5f;
-  const float fx = std::floor(x), fy = std::floor(y);
-  const int x0 = int(fx), y0 = int(fy);
-  const float tx = x - fx, ty = y - fy;
-  const glm::vec4 a = glm::mix(texel(level, x0, y0, s), texel(level, x0 + 1, y0, s), tx);
-  const glm::vec4 b = glm::mix(texel(level, x0, y0 + 1, s), texel(level, x0 + 1, y0 + 1, s), tx);
+  const double x = double(uv.x) * level.width - 0.5, y = double(uv.y) * level.height - 0.5;
+  const double x0 = std::floor(x), y0 = std::floor(y);
+  const float tx = float(x - x0), ty = float(y - y0);
+  const glm::vec4 a = glm::mix(texel(level, x0, y0, s), texel(level, x0 + 1.0, y0, s), tx);
+  const glm::vec4 b = glm::mix(texel(level, x0, y0 + 1.0, s), texel(level, x0 + 1.0, y0 + 1.0, s), tx);
   return glm::mix(a, b, ty);
 }
 
@@ -129,9 +132,6 @@ float TextureSet::levelOfDetail(int texture, const TextureFootprint& fp) const {
 glm::vec4 TextureSet::sample(int texture, glm::vec2 uv, const TextureFootprint& fp,
                              TextureFilter filter) const {
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
-  // Keep texel arithmetic in int range: REPEAT is periodic, and clamped
-  // modes give the edge texel for any uv beyond the image anyway.
-  uv = glm::clamp(uv, glm::vec2(-1e6f), glm::vec2(1e6f));
   const std::vector<MipLevel>& chain = chains_[size_t(texture)];
   const TextureSampler& s = samplers_[size_t(texture)];
   if (filter == TextureFilter::Nearest) return unpremultiply(nearest(chain[0], uv, s));
@@ -151,7 +151,8 @@ glm::vec4 TextureSet::sample(int texture, glm::vec2 uv, const TextureFootprint& 
     return linearInLevel ? bilinear(l, uv, s) : nearest(l, uv, s);
   };
   if (minFilter == 9728 || minFilter == 9729) return unpremultiply(lookup(0));  // no mip-mapping
-  const float lod = std::clamp(lambda, 0.0f, float(maxLevel));
+  // NaN (a footprint of NaNs) reads as level 0, so the conversions below stay in range.
+  const float lod = lambda > 0.0f ? std::min(lambda, float(maxLevel)) : 0.0f;
   if (minFilter == 9984 || minFilter == 9985) return unpremultiply(lookup(int(std::lround(lod))));
   const int lo = int(std::floor(lod));
   const float t = lod - float(lo);

@@ -2,10 +2,15 @@
 // filtered lookups, shared by both renderers.
 //
 // Mip chains are built in linear, premultiplied float RGBA (so filtering
-// neither darkens nor fringes at alpha edges: the premultiplied-alpha
-// argument of the lecture notes), each level a box-filtered half of the one
+// neither darkens nor fringes at alpha edges: a transparent texel adds no
+// colour to its neighbours), each level a box-filtered half of the one
 // above it (OpenImageIO's resize), down to 1×1. Lookups return straight
 // (un-premultiplied) linear RGBA.
+//
+// Wrapping (REPEAT, MIRRORED_REPEAT, CLAMP_TO_EDGE) is exact for any
+// finite uv and any texture size: texel coordinates are formed and wrapped
+// in double and only the wrapped index in [0, size) becomes an int.
+// Non-finite uv samples at uv (0, 0).
 //
 // Level of detail follows OpenGL: rho = max(|duv/dx|, |duv/dy|) in texels
 // of level 0, lambda = log2(rho); lambda <= 0 magnifies.
