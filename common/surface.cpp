@@ -74,6 +74,13 @@ SampleHit refineHit(const Scene& scene, const Ray& ray, const SampleHit& hit) {
   double t;
   glm::dvec2 b;
   if (!intersectTrianglePlane(scene, hit.instance, hit.triangle, ray, &t, &b)) return hit;
+  // A plane behind the origin (or at it) is not what the renderer saw:
+  // keep its hit.
+  if (!(t > 0.0) || !std::isfinite(t * ray.depthPerT)) return hit;
+  // Into the triangle (header): at grazing angles the plane point may fall
+  // just outside, and attributes must not be extrapolated there.
+  b = glm::max(b, glm::dvec2(0.0));
+  if (b.x + b.y > 1.0) b /= b.x + b.y;
   SampleHit refined = hit;
   refined.b1 = float(b.x);
   refined.b2 = float(b.y);

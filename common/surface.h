@@ -40,8 +40,16 @@ SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit);
 bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle, const Ray& ray,
                             double* t, glm::dvec2* barycentrics);
 
-// A hit refined by intersectTrianglePlane (depth = t · depthPerT); the hit
-// unchanged when the plane cannot be intersected.
+// A hit refined by intersectTrianglePlane: depth = t · depthPerT, the
+// view depth of the plane point along the ray, and barycentrics clamped
+// into the triangle: b1, b2 below 0 become 0, then a pair with b1 + b2 > 1
+// is scaled by 1 / (b1 + b2) onto the edge v1–v2 (a point of the
+// triangle near the plane point, not the nearest one). A sample the renderer
+// found inside the triangle whose double-precision plane point lies just
+// outside (grazing angles) is thus shaded from the triangle's edge, never
+// from attributes extrapolated beyond it. The hit is returned unchanged
+// when the plane cannot be intersected or the intersection is not ahead
+// of the ray (t <= 0, or a depth that is not finite).
 SampleHit refineHit(const Scene& scene, const Ray& ray, const SampleHit& hit);
 
 // Texture-space footprint of one pixel at a surface point: d(uv)/dx and
