@@ -130,7 +130,14 @@ std::string visibilityTable(const VisibilityReport& v, const char* a, const char
   for (int c = 0; c < kMismatchClassCount; ++c)
     row(std::string("mismatch: ") + displayName(MismatchClass(c)), v.layers.count(MismatchClass(c)),
         v.layers.fraction(MismatchClass(c)), MismatchClass(c) == MismatchClass::Genuine);
+  row("cut off (not compared)", v.layers.cutOff,
+      v.layers.compared ? double(v.layers.cutOff) / double(v.layers.compared + v.layers.cutOff) : 0.0);
   s += "</table>";
+  if (v.layers.cutOff)
+    s += "<div>colour of the cut-off layers in the renderer that reached them: mean " +
+         fmt("%.3g", v.cutOff.meanColor) + " per pixel, max " + fmt("%.3g", v.cutOff.maxColor) + " at (" +
+         std::to_string(v.cutOff.maxX) + ", " + std::to_string(v.cutOff.maxY) + "), " +
+         std::to_string(v.cutOff.samples) + " samples</div>";
   s += "<div>depth error on agreeing hits: mean " + fmt("%.3g", v.depth.meanAbsolute) + ", max " +
        fmt("%.3g", v.depth.maxAbsolute) + " (relative mean " + fmt("%.3g", v.depth.meanRelative) + ", max " +
        fmt("%.3g", v.depth.maxRelative) + ") over " + std::to_string(v.depth.count) + " hits</div>";
@@ -247,7 +254,7 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
   b += "<table><tr><th class=\"l\">scene</th><th>size</th><th>samples</th><th>layers</th><th>agree</th>";
   for (int c = 0; c < kMismatchClassCount; ++c)
     b += "<th>" + std::string(displayName(MismatchClass(c))) + "</th>";
-  b += "<th>max rel &Delta;Z</th><th>RMS</th><th>PSNR</th><th>hybrid &Delta; where hits agree</th>"
+  b += "<th>cut off</th><th>max rel &Delta;Z</th><th>RMS</th><th>PSNR</th><th>hybrid &Delta; where hits agree</th>"
        "<th>raster s</th><th>raytrace s</th><th>hybrid s</th></tr>";
   for (size_t i = 0; i < results.size(); ++i) {
     const CrossvalResult& r = results[i];
@@ -266,6 +273,7 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
       const bool bad = MismatchClass(c) == MismatchClass::Genuine && n > 0;
       b += std::string("<td") + (bad ? " class=\"bad\"" : "") + ">" + std::to_string(n) + "</td>";
     }
+    b += "<td>" + std::to_string(v.layers.cutOff) + "</td>";
     b += "<td>" + fmt("%.3g", v.depth.maxRelative) + "</td><td>" + fmt("%.3g", r.rasterVsRayColor.rmsError) +
          "</td><td>" +
          (std::isinf(r.rasterVsRayColor.psnr) ? "&infin;" : fmt("%.1f", r.rasterVsRayColor.psnr)) +
@@ -279,7 +287,10 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
        "the edge distance of it (SPEC 3 lets either win). Depth tie: |&Delta;Z| within the depth format's "
        "resolution (z-fighting). Near/far plane: a hit at or beyond a clipping plane. Silhouette edge: the "
        "sample "
-       "lies within the edge distance of an edge of either triangle. Genuine: none of these.</p>";
+       "lies within the edge distance of an edge of either triangle. Genuine: none of these. Cut off: "
+       "layers behind the point where one renderer declared it stopped looking (a transmittance cut-off "
+       "or a layer limit); they are counted apart, neither agreement nor mismatch, with their share of "
+       "the colour.</p>";
   writeTextFile(dir + "/index.html", page("rastray crossval", b));
 }
 

@@ -64,6 +64,7 @@ const std::vector<LegendEntry>& mismatchLegend() {
   static const std::vector<LegendEntry> legend = {
       {PixelVisibility::BothEmpty, "both-empty", "both empty", rgb255(0, 0, 0)},
       {PixelVisibility::Agree, "agree", "agree", rgb255(64, 64, 64)},
+      {PixelVisibility::CutOff, "cut-off", "cut off (one renderer stopped early)", rgb255(150, 110, 60)},
       {PixelVisibility::SilhouetteEdge, toString(MismatchClass::SilhouetteEdge),
        displayName(MismatchClass::SilhouetteEdge), rgb255(66, 135, 245)},
       {PixelVisibility::SharedEdgeTie, toString(MismatchClass::SharedEdgeTie),

@@ -14,8 +14,12 @@ namespace {
 // layers front to back (background entries dropped).
 struct LayeredFrame {
   int width = 0, height = 0, slots = 1;
-  std::vector<uint32_t> offsets;  // width·height·slots + 1
+  std::vector<uint64_t> offsets;  // width·height·slots + 1
   std::vector<HitRecord> hits;
+  std::vector<glm::vec4> colors;  // per hit, premultiplied (deep frames; empty for flat ones)
+  // Per slot: 1 + the index of the layer the renderer stopped looking
+  // behind (DeepSample::cutOff); 0: it did not stop early.
+  std::vector<uint32_t> cutOff;
 
   size_t slot(int x, int y, int s) const {
     return (size_t(y) * size_t(width) + size_t(x)) * size_t(slots) + size_t(s);
@@ -31,12 +35,13 @@ LayeredFrame fromFlat(const FlatImage& image) {
   f.width = image.width;
   f.height = image.height;
   const size_t n = size_t(image.width) * size_t(image.height);
+  f.cutOff.assign(n, 0);
   f.offsets.reserve(n + 1);
   f.offsets.push_back(0);
   for (size_t i = 0; i < n; ++i) {
     HitRecord h{image.instance[i], image.triangle[i], image.depth[i]};
     if (h.isHit()) f.hits.push_back(h);
-    f.offsets.push_back(uint32_t(f.hits.size()));
+    f.offsets.push_back(uint64_t(f.hits.size()));
   }
   return f;
 }
@@ -52,7 +57,7 @@ LayeredFrame fromDeep(const DeepImage& image, int spp, const std::string& name) 
   // back within each sample).
   std::vector<uint32_t> counts(pixels * size_t(spp), 0);
   for (size_t p = 0; p < pixels; ++p) {
-    for (uint32_t i = image.offsets[p]; i < image.offsets[p + 1]; ++i) {
+    for (uint64_t i = image.offsets[p]; i < image.offsets[p + 1]; ++i) {
       const DeepSample& d = image.samples[i];
       if (d.sample >= uint32_t(spp)) {
         const int x = int(p % size_t(image.width)), y = int(p / size_t(image.width));
@@ -64,12 +69,18 @@ LayeredFrame fromDeep(const DeepImage& image, int spp, const std::string& name) 
   }
   for (size_t s = 0; s < counts.size(); ++s) f.offsets[s + 1] = f.offsets[s] + counts[s];
   f.hits.resize(f.offsets.back());
-  std::vector<uint32_t> next(f.offsets.begin(), f.offsets.end() - 1);
+  f.colors.resize(f.offsets.back());
+  f.cutOff.assign(counts.size(), 0);
+  std::vector<uint64_t> next(f.offsets.begin(), f.offsets.end() - 1);
   for (size_t p = 0; p < pixels; ++p)
-    for (uint32_t i = image.offsets[p]; i < image.offsets[p + 1]; ++i) {
+    for (uint64_t i = image.offsets[p]; i < image.offsets[p + 1]; ++i) {
       const DeepSample& d = image.samples[i];
       const HitRecord h{d.instance, d.triangle, d.depth};
-      if (h.isHit()) f.hits[next[p * size_t(spp) + d.sample]++] = h;
+      const size_t slot = p * size_t(spp) + d.sample;
+      if (!h.isHit()) continue;
+      if (d.cutOff) f.cutOff[slot] = next[slot] - f.offsets[slot] + 1;
+      f.colors[next[slot]] = d.color;
+      f.hits[next[slot]++] = h;
     }
   return f;
 }
@@ -185,11 +196,13 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
   r.pixels.assign(pixels, PixelVisibility::BothEmpty);
   r.pixelDepthError.assign(pixels, std::nanf(""));
   double sumAbs = 0.0, sumRel = 0.0;
+  double sumCutOffColor = 0.0;
   const HitRecord empty;
   for (int y = 0; y < fa.height; ++y)
     for (int x = 0; x < fa.width; ++x) {
       const size_t pixel = size_t(y) * size_t(fa.width) + size_t(x);
       PixelVisibility& vis = r.pixels[pixel];
+      glm::dvec4 cutOffColor(0.0);  // this pixel's share of colour in cut-off layers
       for (int s = 0; s < fa.slots; ++s) {
         const size_t slot = fa.slot(x, y, s);
         const HitRecord* la = fa.begin(slot);
@@ -240,10 +253,54 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
         // subsequence of the two front-to-back lists; between matched
         // layers, the unmatched ones are paired in order, and the rest are
         // compared with nothing.
-        for (const auto& [ia, ib] : alignLayers(la, na, lb, nb))
+        // Layers behind the last one of a renderer that declared a cut-off
+        // there are cut off, not compared (see the header).
+        const auto aligned = alignLayers(la, na, lb, nb);
+        // Alignment entries after the one holding a side's cut-off layer.
+        const uint32_t cutA = fa.cutOff.empty() ? 0 : fa.cutOff[slot];
+        const uint32_t cutB = fb.cutOff.empty() ? 0 : fb.cutOff[slot];
+        size_t behindA = aligned.size(), behindB = aligned.size();
+        for (size_t k = 0; k < aligned.size(); ++k) {
+          if (cutA && aligned[k].first + 1 == cutA) behindA = k + 1;
+          if (cutB && aligned[k].second + 1 == cutB) behindB = k + 1;
+        }
+        bool sampleCutOff = false;
+        for (size_t k = 0; k < aligned.size(); ++k) {
+          const auto [ia, ib] = aligned[k];
+          const bool cutOffByA = k >= behindA && ia >= na && ib < nb;  // only B has it
+          const bool cutOffByB = k >= behindB && ib >= nb && ia < na;
+          if (cutOffByA || cutOffByB) {
+            ++r.layers.cutOff;
+            sampleCutOff = true;
+            vis = std::max(vis, PixelVisibility::CutOff);
+            // Its colour in the renderer that reached it: the layer's own
+            // premultiplied colour behind the transmittance in front of it.
+            const LayeredFrame& full = cutOffByA ? fb : fa;
+            const size_t layer = cutOffByA ? ib : ia;
+            if (!full.colors.empty()) {
+              const size_t first = full.offsets[slot];
+              double transmittance = 1.0;
+              for (size_t j = 0; j < layer; ++j) transmittance *= 1.0 - double(full.colors[first + j].a);
+              cutOffColor += transmittance * glm::dvec4(full.colors[first + layer]);
+            }
+            continue;
+          }
           record(ia < na ? la[ia] : empty, ib < nb ? lb[ib] : empty, std::min(ia, ib), r.layers, true);
+        }
+        r.cutOff.samples += sampleCutOff;
+      }
+      cutOffColor /= double(fa.slots);
+      const double share =
+          std::max(std::max(std::fabs(cutOffColor.r), std::fabs(cutOffColor.g)),
+                   std::max(std::fabs(cutOffColor.b), std::fabs(cutOffColor.a)));
+      sumCutOffColor += share;
+      if (share > r.cutOff.maxColor) {
+        r.cutOff.maxColor = share;
+        r.cutOff.maxX = x;
+        r.cutOff.maxY = y;
       }
     }
+  if (pixels) r.cutOff.meanColor = sumCutOffColor / double(pixels);
   if (r.depth.count) {
     r.depth.meanAbsolute = sumAbs / double(r.depth.count);
     r.depth.meanRelative = sumRel / double(r.depth.count);

@@ -12,6 +12,12 @@
 //   no hit in either file counts as one empty layer, so layers compared >=
 //   samples compared. A sample agrees when its front layers agree.
 // - Both empty agrees. A hit against nothing is a mismatch like any other.
+// - Cut off (SPEC §6): when a renderer stopped looking behind a layer (a
+//   transmittance cut-off or a layer limit: DeepSample::cutOff), the other
+//   renderer's layers aligned behind its last one are counted as cut off,
+//   not compared: they are neither agreement nor mismatch, so a mismatch
+//   count never exceeds what was compared. Their share of the colour (what
+//   the other renderer composited from them) is reported in CutOffStats.
 // Depth error statistics cover agreeing units where both depths are finite:
 // absolute |ZA − ZB| and relative |ZA − ZB| / max(ZA, ZB) (0 when both are 0).
 #pragma once
@@ -32,12 +38,23 @@ struct AgreementCounts {
   uint64_t agreeing = 0;  // including bothEmpty
   uint64_t bothEmpty = 0;
   std::array<uint64_t, kMismatchClassCount> mismatches{};
+  uint64_t cutOff = 0;  // layers behind a renderer's declared cut-off: not compared
 
   uint64_t mismatching() const { return compared - agreeing; }
   uint64_t count(MismatchClass c) const { return mismatches[size_t(c)]; }
   // 1 when nothing was compared (an empty image agrees with itself).
   double agreement() const { return compared ? double(agreeing) / double(compared) : 1.0; }
   double fraction(MismatchClass c) const { return compared ? double(count(c)) / double(compared) : 0.0; }
+};
+
+// The colour the cut-off layers carry in the renderer that did reach them:
+// per pixel, the box filter over its samples of Σ T_k · C_k over the cut-off
+// layers k (C_k premultiplied, T_k the transmittance in front of layer k).
+struct CutOffStats {
+  uint64_t samples = 0;      // samples with at least one cut-off layer
+  double meanColor = 0.0;    // mean over all pixels of the largest RGBA channel of that share
+  double maxColor = 0.0;     // largest over pixels
+  int maxX = -1, maxY = -1;  // pixel of maxColor
 };
 
 struct DepthErrorStats {
@@ -61,6 +78,7 @@ struct MismatchExample {
 enum class PixelVisibility : uint8_t {
   BothEmpty,
   Agree,
+  CutOff,  // agrees wherever both looked; one renderer stopped early
   SilhouetteEdge,
   SharedEdgeTie,
   DepthTie,
@@ -80,6 +98,7 @@ struct VisibilityReport {
   AgreementCounts samples;  // flat: pixels
   AgreementCounts layers;   // flat: the same as samples
   DepthErrorStats depth;
+  CutOffStats cutOff;
   std::array<std::optional<MismatchExample>, kMismatchClassCount> examples;
   std::vector<PixelVisibility> pixels;  // width·height, row 0 at the top
   std::vector<float> pixelDepthError;   // max |ΔZ| over agreeing finite hits; NaN: none

@@ -233,7 +233,10 @@ void Renderer::renderTile(const TileRect& rect, const std::vector<uint32_t>& opa
               (size_t(py - rect.y0) * size_t(w) + size_t(px - rect.x0)) * size_t(spp) + size_t(s);
           for (; li < layers.size() && layers[li].local == local; ++li, ++c) {
             const Layer& l = layers[li];
-            deep->push_back({l.color, l.hit.depth, l.hit.instance, l.hit.triangle, uint32_t(s)});
+            // Peeling stops after its last pass: it did not look behind that layer.
+            const bool cutOff = options_.transparency == TransparencyMode::Peel &&
+                                l.rank + 1 == uint32_t(options_.peelLayers);
+            deep->push_back({l.color, l.hit.depth, l.hit.instance, l.hit.triangle, uint32_t(s), cutOff});
           }
           const uint32_t win = target->winners[target->index(px, py, s)];
           if (win == kNoSetup) continue;

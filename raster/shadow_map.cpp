@@ -76,7 +76,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
           kMapFormat, c.projection, c.znear, c.zfar, options.shadowBiasSlope, options.shadowBiasConstant};
       SetupCounters counters;
       const std::vector<TriangleSetup> setups =
-          prepareTriangles(scene, map.space, grid, ds, CullMode::None, {true, true}, &counters);
+          prepareTriangles(scene, map.space, grid, ds, options.cull, {true, true}, &counters);
       triangles_ += counters.trianglesIn;
       const TileGrid tiles(size, size);
       // BLEND and refractive surfaces attenuate instead of blocking (with a

@@ -31,8 +31,9 @@ const char* errorName(RTCError code) {
 
 }  // namespace
 
-bool needsFilter(const Material& material) {
-  return material.alphaMode != AlphaMode::Opaque || material.isRefractive();
+bool needsFilter(const Material& material, bool sceneNeedsFilters, CullMode cull) {
+  if (cull != CullMode::None && !material.doubleSided) return true;
+  return sceneNeedsFilters && (material.alphaMode != AlphaMode::Opaque || material.isRefractive());
 }
 
 void EmbreeScene::onError(void* userPtr, RTCError code, const char* message) {
@@ -51,7 +52,7 @@ void EmbreeScene::throwIfError() {
   throw std::runtime_error(text);
 }
 
-EmbreeScene::EmbreeScene(const Scene& scene, const SceneAnalysis& analysis,
+EmbreeScene::EmbreeScene(const Scene& scene, const SceneAnalysis& analysis, CullMode cull,
                          RTCFilterFunctionN intersectFilter, RTCFilterFunctionN occludedFilter,
                          void* filterUserPtr) {
   device_ = rtcNewDevice(nullptr);
@@ -99,7 +100,7 @@ EmbreeScene::EmbreeScene(const Scene& scene, const SceneAnalysis& analysis,
       indices[3 * t + 1] = local.y;
       indices[3 * t + 2] = local.z;
     }
-    if (filters && needsFilter(scene.materials[inst.material])) {
+    if (needsFilter(scene.materials[inst.material], filters, cull)) {
       rtcSetGeometryUserData(geometry, filterUserPtr);
       rtcSetGeometryIntersectFilterFunction(geometry, intersectFilter);
       rtcSetGeometryOccludedFilterFunction(geometry, occludedFilter);

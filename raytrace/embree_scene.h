@@ -21,9 +21,10 @@
 // their primID but get the index triple (v0, v0, v0): Embree's triangle
 // test rejects a zero denominator, so they cover nothing (SPEC §1).
 //
-// Filters: only when the scene needs them (SceneAnalysis::needsRayFilters),
-// and then only on geometries whose material is MASK, BLEND or refractive;
-// opaque geometries are accepted by Embree directly.
+// Filters: only on the geometries that need them: MASK, BLEND or refractive
+// materials (when SceneAnalysis::needsRayFilters), and, with face culling,
+// single-sided materials (SPEC §3). Every other geometry is accepted by
+// Embree directly.
 #pragma once
 
 #include <embree3/rtcore.h>
@@ -32,6 +33,7 @@
 #include <string>
 
 #include "common/analysis.h"
+#include "common/cull.h"
 #include "common/scene.h"
 
 namespace rastray {
@@ -39,8 +41,8 @@ namespace rastray {
 class EmbreeScene {
  public:
   // `filterUserPtr` is handed to the filter callbacks as geometryUserPtr.
-  EmbreeScene(const Scene& scene, const SceneAnalysis& analysis, RTCFilterFunctionN intersectFilter,
-              RTCFilterFunctionN occludedFilter, void* filterUserPtr);
+  EmbreeScene(const Scene& scene, const SceneAnalysis& analysis, CullMode cull,
+              RTCFilterFunctionN intersectFilter, RTCFilterFunctionN occludedFilter, void* filterUserPtr);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -63,6 +65,6 @@ class EmbreeScene {
 };
 
 // True for materials whose hits a filter callback must see.
-bool needsFilter(const Material& material);
+bool needsFilter(const Material& material, bool sceneNeedsFilters, CullMode cull);
 
 }  // namespace rastray

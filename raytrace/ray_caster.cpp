@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cfloat>
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
@@ -111,63 +110,133 @@ RTCRayHit makeRayHit(const glm::vec3& origin, const glm::vec3& direction, float 
   return rh;
 }
 
-// Largest absolute coordinate of a stored triangle's vertices.
-float vertexScale(const Scene& scene, uint32_t instance, uint32_t triangle) {
-  const glm::uvec3 t = scene.triangle(instance, triangle);
-  float m = 0.0f;
-  for (int k = 0; k < 3; ++k) {
-    const glm::vec3& p = scene.positions[t[k]];
-    m = std::max({m, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+// The relation of two hits on one ray: how many crossings they are.
+enum class Crossing { Two, KeepFirst, KeepSecond };
+
+// Two reported hits are one crossing of one surface (SPEC §1, §3) when
+// they are the same (instance, triangle), or when their triangles are
+// adjacent across the ray: they share a vertex position p and, projected
+// along the ray, lie on opposite sides of a line through p along one of
+// their edges. Embree's watertight test may report both triangles of a
+// shared edge (or several of a fan around a shared vertex), but a ray can
+// meet both closed half-planes only on their common line, so such a pair
+// is always one crossing, whatever t rounding says. Coincident duplicates
+// (the same three positions) and folded pairs (same side) stay two layers.
+//
+// Which one is kept is decided like the rasterizer's top-left rule, by an
+// exact-sign test evaluated once per pair: the side s of the ray's origin
+// relative to the separating line, with the line's endpoints in canonical
+// (lexicographic) order so the decision does not depend on which triangle
+// is asked; the triangle on the ray's side wins, and on s == 0 (the ray
+// exactly on the line) the one on the positive side. In double from the
+// float vertex data; the projection is parallel to the ray direction.
+class CrossingRule {
+ public:
+  CrossingRule(const Scene& scene, const glm::dvec3& origin, const glm::dvec3& direction)
+      : scene_(scene), origin_(origin), direction_(direction) {}
+
+  Crossing classify(const GatheredHit& first, const GatheredHit& second) const {
+    if (first.instance == second.instance && first.triangle == second.triangle) return Crossing::KeepFirst;
+    const std::array<glm::dvec3, 3> a = corners(first), b = corners(second);
+    if (samePositionSet(a, b)) return Crossing::Two;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        if (a[i] != b[j]) continue;
+        // p = a[i] = b[j]; the candidate lines run from p along the other
+        // triangles' edges.
+        const glm::dvec3& p = a[i];
+        for (const glm::dvec3& x : {a[(i + 1) % 3], a[(i + 2) % 3], b[(j + 1) % 3], b[(j + 2) % 3]}) {
+          if (x == p) continue;
+          const Crossing c = separated(p, x, a, b);
+          if (c != Crossing::Two) return c;
+        }
+      }
+    return Crossing::Two;
   }
-  return m;
-}
 
-bool sharesVertexPosition(const Scene& scene, uint32_t instance, uint32_t a, uint32_t b) {
-  const glm::uvec3 ta = scene.triangle(instance, a), tb = scene.triangle(instance, b);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (ta[i] == tb[j] || scene.positions[ta[i]] == scene.positions[tb[j]]) return true;
-  return false;
-}
+ private:
+  std::array<glm::dvec3, 3> corners(const GatheredHit& h) const {
+    const glm::uvec3 t = scene_.triangle(h.instance, h.triangle);
+    return {glm::dvec3(scene_.positions[t.x]), glm::dvec3(scene_.positions[t.y]),
+            glm::dvec3(scene_.positions[t.z])};
+  }
 
-// Removes repeated crossings of one surface, after sorting by (t,
-// instance, triangle):
-// - the same (instance, triangle) twice (a plane is crossed once);
-// - two triangles of one instance that share a vertex position, hit at t
-//   values equal up to the rounding error of Embree's float t: the ray
-//   went through their common edge or vertex (Embree's watertight test
-//   reports both), which is one crossing. The bound is 32 float ULPs of
-//   the magnitudes the intersection subtracts (t, the origin and the
-//   vertex coordinates), so it scales with the scene.
-// The first in (t, instance, triangle) order is kept.
-void sortAndDedupe(const Scene& scene, const glm::vec3& origin, std::vector<GatheredHit>* hits) {
+  static bool samePositionSet(const std::array<glm::dvec3, 3>& a, const std::array<glm::dvec3, 3>& b) {
+    for (const glm::dvec3& p : a)
+      if (std::find(b.begin(), b.end(), p) == b.end()) return false;
+    for (const glm::dvec3& p : b)
+      if (std::find(a.begin(), a.end(), p) == a.end()) return false;
+    return true;
+  }
+
+  static bool lexicographicLess(const glm::dvec3& u, const glm::dvec3& v) {
+    if (u.x != v.x) return u.x < v.x;
+    if (u.y != v.y) return u.y < v.y;
+    return u.z < v.z;
+  }
+
+  // Sign of the side of q relative to the plane through the line (p, x)
+  // that contains the ray direction: +1, -1 or 0.
+  int side(const glm::dvec3& p, const glm::dvec3& x, const glm::dvec3& q) const {
+    const double s = glm::dot(glm::cross(x - p, direction_), q - p);
+    return (s > 0.0) - (s < 0.0);
+  }
+
+  // Whether the line (p, x) separates the triangles; then which one the
+  // ray belongs to.
+  Crossing separated(glm::dvec3 p, glm::dvec3 x, const std::array<glm::dvec3, 3>& a,
+                     const std::array<glm::dvec3, 3>& b) const {
+    if (lexicographicLess(x, p)) std::swap(p, x);
+    auto sideOf = [&](const std::array<glm::dvec3, 3>& t) {
+      int s = 0;
+      for (const glm::dvec3& q : t) {
+        if (q == p || q == x) continue;
+        const int k = side(p, x, q);
+        if (k == 0 || (s != 0 && k != s)) return 0;  // touches or straddles the line
+        s = k;
+      }
+      return s;
+    };
+    const int sa = sideOf(a), sb = sideOf(b);
+    if (sa == 0 || sb == 0 || sa == sb) return Crossing::Two;
+    const double ray = glm::dot(glm::cross(x - p, direction_), origin_ - p);
+    const int owner = ray > 0.0 ? 1 : ray < 0.0 ? -1 : 1;
+    return owner == sa ? Crossing::KeepFirst : Crossing::KeepSecond;
+  }
+
+  const Scene& scene_;
+  glm::dvec3 origin_, direction_;
+};
+
+// Sorts hits by (t, instance, triangle) and keeps one hit per crossing
+// (CrossingRule).
+void sortAndMergeCrossings(const Scene& scene, const Ray& ray, std::vector<GatheredHit>* hits) {
   std::sort(hits->begin(), hits->end(), [](const GatheredHit& a, const GatheredHit& b) {
     if (a.t != b.t) return a.t < b.t;
     if (a.instance != b.instance) return a.instance < b.instance;
     return a.triangle < b.triangle;
   });
-  const float originScale = std::max({std::fabs(origin.x), std::fabs(origin.y), std::fabs(origin.z)});
-  size_t kept = 0;
-  for (size_t i = 0; i < hits->size(); ++i) {
-    const GatheredHit& h = (*hits)[i];
-    bool duplicate = false;
-    for (size_t k = 0; k < kept && !duplicate; ++k) {
-      const GatheredHit& o = (*hits)[k];
-      if (o.instance != h.instance) continue;
-      if (o.triangle == h.triangle) {
-        duplicate = true;
-        break;
+  const CrossingRule rule(scene, ray.origin, ray.direction);
+  std::vector<GatheredHit> kept;
+  kept.reserve(hits->size());
+  for (const GatheredHit& h : *hits) {
+    bool keep = true;
+    for (size_t k = 0; k < kept.size() && keep;) {
+      switch (rule.classify(kept[k], h)) {
+        case Crossing::Two:
+          ++k;
+          break;
+        case Crossing::KeepFirst:
+          keep = false;
+          break;
+        case Crossing::KeepSecond:
+          kept.erase(kept.begin() + std::ptrdiff_t(k));
+          break;
       }
-      const float scale =
-          std::fabs(h.t) + originScale +
-          std::max(vertexScale(scene, h.instance, h.triangle), vertexScale(scene, o.instance, o.triangle));
-      if (h.t - o.t <= 32.0f * FLT_EPSILON * scale &&
-          sharesVertexPosition(scene, h.instance, h.triangle, o.triangle))
-        duplicate = true;
     }
-    if (!duplicate) (*hits)[kept++] = h;
+    if (keep) kept.push_back(h);
   }
-  hits->resize(kept);
+  hits->swap(kept);
 }
 
 std::string fmt3(const glm::dvec3& v) {
@@ -193,7 +262,9 @@ struct RayCaster::Impl {
   mutable tbb::enumerable_thread_specific<std::array<uint64_t, kRayKindCount>> counts{
       std::array<uint64_t, kRayKindCount>{}};
 
-  Impl(const Scene& s, const SceneAnalysis& a) : scene(s), analysis(a) {}
+  const CullMode cull;
+
+  Impl(const Scene& s, const SceneAnalysis& a, CullMode c) : scene(s), analysis(a), cull(c) {}
 
   void count(RayKind kind, uint64_t n = 1) const {
     if (tTrace) return;  // debug traces re-trace rays the render already counted
@@ -221,9 +292,18 @@ struct RayCaster::Impl {
     return shader->coverageAlpha(p, fp) >= p.material->alphaCutoff;
   }
 
+  // Front-facing: the stored vertices run counter-clockwise seen along the
+  // ray (normal cross(b − a, c − a) against the direction), in double.
+  bool isFrontFacing(const GatheredHit& hit, const glm::dvec3& direction) const {
+    const glm::uvec3 t = scene.triangle(hit.instance, hit.triangle);
+    const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
+    return glm::dot(glm::cross(b - a, c - a), direction) < 0.0;
+  }
+
   // Accept (true) or reject (false, traversal continues) one hit.
   bool filterHit(HitGather& g, const GatheredHit& hit) const {
     const Material& m = scene.materialOf(hit.instance);
+    if (cull != CullMode::None && isCulled(cull, m, isFrontFacing(hit, g.ray.direction))) return false;
     if (m.alphaMode == AlphaMode::Mask) {
       const SurfacePoint p = pointOf(g, hit.instance, hit.triangle, hit.u, hit.v, hit.t);
       if (!maskCovers(g, p)) return false;  // not there: ignored
@@ -275,8 +355,7 @@ struct RayCaster::Impl {
     bool blend = false;
   };
 
-  void collectLayers(HitGather& g, const glm::vec3& origin, const GatheredHit& closest,
-                     std::vector<Layer>* layers) const {
+  void collectLayers(HitGather& g, const GatheredHit& closest, std::vector<Layer>* layers) const {
     layers->clear();
     if (closest.instance != kNoId) {
       // Layers Embree reported before it found a closer stopping hit lie
@@ -286,7 +365,7 @@ struct RayCaster::Impl {
           g.hits.end());
       g.hits.push_back(closest);
     }
-    if (g.hits.size() > 1) sortAndDedupe(scene, origin, &g.hits);
+    if (g.hits.size() > 1) sortAndMergeCrossings(scene, g.ray, &g.hits);
     for (const GatheredHit& h : g.hits) {
       Layer layer;
       SampleHit raw;
@@ -344,7 +423,7 @@ struct RayCaster::Impl {
 
   void traceRadiance(HitGather& g, bool coherent, std::vector<Layer>* layers) const {
     const GatheredHit closest = intersectSingle(g, coherent);
-    collectLayers(g, glm::vec3(g.ray.origin), closest, layers);
+    collectLayers(g, closest, layers);
   }
 
   // Front-to-back compositing of a ray's layers with premultiplied `over`
@@ -358,7 +437,11 @@ struct RayCaster::Impl {
     int n = 0;
     for (const Layer& layer : layers) {
       const float remaining = 1.0f - acc.a;
-      if (remaining < options.transparencyCutoff) break;
+      if (remaining < options.transparencyCutoff) {
+        // Stopped with layers left: the deep output says so (SPEC §6).
+        if (deep && !deep->empty()) deep->back().cutOff = true;
+        break;
+      }
       const SurfacePoint p = makeSurfacePoint(scene, layer.hit);
       const TextureFootprint fp =
           g.primary ? pixelFootprint(scene, camera, p, g.imagePosition) : TextureFootprint{};
@@ -391,7 +474,7 @@ struct RayCaster::Impl {
 
   SampleResult resolvePrimary(HitGather& g, const GatheredHit& closest, uint32_t sampleIndex,
                               std::vector<DeepSample>* deep, std::vector<Layer>* layers) const {
-    collectLayers(g, glm::vec3(g.ray.origin), closest, layers);
+    collectLayers(g, closest, layers);
     SampleResult r;
     if (!layers->empty()) {
       r.front = layers->front().hit;
@@ -512,7 +595,7 @@ struct RayCaster::Impl {
     if (blocked) {
       result = glm::vec3(0.0f);
     } else if (!g.hits.empty()) {
-      sortAndDedupe(scene, origin, &g.hits);
+      sortAndMergeCrossings(scene, g.ray, &g.hits);
       for (const GatheredHit& h : g.hits)
         result *= shader->shadowTransmittance(pointOf(g, h.instance, h.triangle, h.u, h.v, h.t));
     }
@@ -680,10 +763,10 @@ RenderOutput RayCaster::Impl::render() const {
     out.samples.offsets.assign(deep.size() + 1, 0);
     size_t total = 0;
     for (size_t i = 0; i < deep.size(); ++i) {
-      out.samples.offsets[i] = uint32_t(total);
+      out.samples.offsets[i] = total;
       total += deep[i].size();
     }
-    out.samples.offsets[deep.size()] = uint32_t(total);
+    out.samples.offsets[deep.size()] = total;
     out.samples.samples.reserve(total);
     for (auto& d : deep) out.samples.samples.insert(out.samples.samples.end(), d.begin(), d.end());
   }
@@ -692,9 +775,10 @@ RenderOutput RayCaster::Impl::render() const {
 
 // ---------------------------------------------------------------------------
 
-RayCaster::RayCaster(const Scene& scene, const SceneAnalysis& analysis)
-    : impl_(std::make_unique<Impl>(scene, analysis)) {
-  impl_->embree = std::make_unique<EmbreeScene>(scene, analysis, &Impl::filter, &Impl::filter, impl_.get());
+RayCaster::RayCaster(const Scene& scene, const SceneAnalysis& analysis, CullMode cull)
+    : impl_(std::make_unique<Impl>(scene, analysis, cull)) {
+  impl_->embree =
+      std::make_unique<EmbreeScene>(scene, analysis, cull, &Impl::filter, &Impl::filter, impl_.get());
 }
 
 RayCaster::~RayCaster() = default;
@@ -732,6 +816,10 @@ RenderOutput RayCaster::render() {
   pass(a.refraction, "refraction rays", Work::RefractionRays);
   pass(a.transparency, "transparency continuation", Work::TransparencyPass);
   pass(a.alphaTest, "alpha test (filter callbacks)", Work::AlphaTest);
+  if (impl_->cull != CullMode::None)
+    out.passesRun.push_back(std::string(impl_->cull == CullMode::Back ? "back" : "front") +
+                            "-face culling (filters on " + std::to_string(impl_->embree->filterGeometries()) +
+                            " single-sided geometries)");
   if (impl_->options.debugPixel) {
     const glm::ivec2 p = *impl_->options.debugPixel;
     if (p.x >= 0 && p.y >= 0 && p.x < impl_->camera.width && p.y < impl_->camera.height)

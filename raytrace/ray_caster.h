@@ -56,6 +56,7 @@
 
 #include "common/analysis.h"
 #include "common/camera.h"
+#include "common/cull.h"
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "common/shading.h"
@@ -100,8 +101,10 @@ struct RayRecord {
 class RayCaster : public SecondaryRayTracer, public LightVisibility {
  public:
   // Builds the Embree device and scene from the shared triangle store.
-  // `scene` must outlive the caster; `analysis` is copied.
-  RayCaster(const Scene& scene, const SceneAnalysis& analysis);
+  // `scene` must outlive the caster; `analysis` is copied. `cull` drops
+  // single-sided triangles seen from the culled side by every ray, primary
+  // and secondary (SPEC §3), through a filter on those geometries only.
+  RayCaster(const Scene& scene, const SceneAnalysis& analysis, CullMode cull = CullMode::None);
   ~RayCaster() override;
   RayCaster(const RayCaster&) = delete;
   RayCaster& operator=(const RayCaster&) = delete;

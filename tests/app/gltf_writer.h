@@ -1,0 +1,62 @@
+// Writes small glTF 2.0 files from code, for tests that run the real binary
+// on generated scenes (regression cases and random scenes): positions and
+// uint32 indices in one base64 data-URI buffer, metallic-roughness
+// materials with KHR_materials_transmission/ior, one optional camera
+// (placed by eye/target/up) and KHR_lights_punctual lights.
+#pragma once
+
+#include <glm/glm.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rastray::test {
+
+struct GltfMaterial {
+  glm::vec4 baseColor{1.0f};
+  float metallic = 0.0f, roughness = 1.0f;
+  std::string alphaMode = "OPAQUE";  // OPAQUE, MASK, BLEND
+  float alphaCutoff = 0.5f;
+  bool doubleSided = false;
+  float transmission = 0.0f;  // > 0 writes KHR_materials_transmission (and ior)
+  float ior = 1.5f;
+};
+
+// One mesh with one TRIANGLES primitive, on its own node.
+struct GltfMesh {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;  // three per triangle
+  int material = 0;
+  glm::dvec3 translation{0.0};  // the node's translation (kept exact in the file)
+};
+
+struct GltfCamera {
+  glm::dvec3 eye{0.0, 0.0, 3.0}, target{0.0}, up{0.0, 1.0, 0.0};
+  double yfov = 0.8;  // radians
+  double znear = 0.1;
+  std::optional<double> zfar;  // absent: infinite
+};
+
+struct GltfLight {
+  std::string type = "directional";      // directional, point
+  glm::dvec3 position{0.0};              // point
+  glm::dvec3 direction{0.0, -1.0, 0.0};  // directional: the way light travels
+  float intensity = 3.0f;
+};
+
+struct GltfScene {
+  std::vector<GltfMaterial> materials;
+  std::vector<GltfMesh> meshes;
+  std::optional<GltfCamera> camera;
+  std::vector<GltfLight> lights;
+
+  std::string toJson() const;
+  void write(const std::string& path) const;  // throws std::runtime_error when it cannot
+};
+
+// A node transform that maps the node's −Z to `forward` (camera, light
+// convention) from `eye`, with +Y as close to `up` as possible: a column-
+// major 4×4 matrix as glTF's "matrix".
+std::vector<double> lookAtNodeMatrix(const glm::dvec3& eye, const glm::dvec3& forward, glm::dvec3 up);
+
+}  // namespace rastray::test
