@@ -3,27 +3,27 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/depth_formula.h"
+
 namespace rastray {
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Window depth derivative |dz/dd| at view depth d (see the header).
-double windowDepthSlope(const DepthPlanes& p, double d) {
-  const double n = p.znear, f = p.zfar;
-  if (p.projection == Projection::Orthographic) return 1.0 / (f - n);
-  if (std::isinf(f)) return n / (d * d);
-  return n * f / ((f - n) * d * d);
-}
-
-// The value the format stores at view depth d, before rounding.
-double storedValue(StoredDepthFormat format, const DepthPlanes& p, double d) {
-  const double n = p.znear, f = p.zfar;
-  const bool reversed = format == StoredDepthFormat::FloatReversed;
-  if (p.projection == Projection::Orthographic) return reversed ? (f - d) / (f - n) : (d - n) / (f - n);
-  if (std::isinf(f)) return reversed ? n / d : 1.0 - n / d;
-  return reversed ? n * (f - d) / (d * (f - n)) : f * (d - n) / (d * (f - n));
+// The shared encoding of a stored format (common/depth_formula.h).
+DepthEncoding encodingOf(StoredDepthFormat format) {
+  switch (format) {
+    case StoredDepthFormat::FloatReversed:
+      return DepthEncoding::FloatReversed;
+    case StoredDepthFormat::Float:
+      return DepthEncoding::Float;
+    case StoredDepthFormat::Unorm24:
+      return DepthEncoding::Unorm24;
+    case StoredDepthFormat::Unorm16:
+      return DepthEncoding::Unorm16;
+  }
+  return DepthEncoding::FloatReversed;
 }
 
 }  // namespace
@@ -102,34 +102,13 @@ std::string depthFormatFormula(StoredDepthFormat f) {
   return "?";
 }
 
-double ulp32(double x) {
-  x = std::fabs(x);
-  if (!std::isfinite(x)) return kInf;
-  if (x < std::ldexp(1.0, -126)) return std::ldexp(1.0, -149);  // denormal range: fixed step
-  int e;
-  std::frexp(x, &e);  // x = m·2^e, m in [0.5, 1): IEEE exponent e − 1
-  return std::ldexp(1.0, (e - 1) - 23);
-}
+double ulp32(double x) { return float32Ulp(x); }
 
 double depthResolution(StoredDepthFormat format, const DepthPlanes& planes, double d) {
   if (!(d > 0.0) || std::isinf(d)) return kInf;
   if (!planes.known) return format == StoredDepthFormat::FloatReversed ? d * std::ldexp(1.0, -23) : kInf;
-  double step = 0.0;
-  switch (format) {
-    case StoredDepthFormat::Unorm24:
-      step = std::ldexp(1.0, -24);
-      break;
-    case StoredDepthFormat::Unorm16:
-      step = std::ldexp(1.0, -16);
-      break;
-    case StoredDepthFormat::Float:
-    case StoredDepthFormat::FloatReversed:
-      // Clamped to [0, 1] as the depth buffer clamps: beyond the planes the
-      // stored value saturates.
-      step = ulp32(std::clamp(storedValue(format, planes, d), 0.0, 1.0));
-      break;
-  }
-  return step / windowDepthSlope(planes, d);
+  // The formulas the rasterizer stores with: step at the stored value / |dz/dd|.
+  return viewDepthResolution(encodingOf(format), planes.projection, planes.znear, planes.zfar, d);
 }
 
 double depthTieTolerance(StoredDepthFormat format, const DepthPlanes& planes, double dA, double dB) {

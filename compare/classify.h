@@ -40,7 +40,8 @@
 // patterns sit on a 1/16 pixel grid) is still reported as genuine.
 //
 // Depth formats: the window depth z in [0, 1] of view depth d (znear n,
-// zfar f, f may be +inf for perspective) is, as in the rasterizer,
+// zfar f, f may be +inf for perspective) is, by the formulas the rasterizer
+// stores with (common/depth_formula.h, one definition for both),
 //   perspective: z = f(d − n) / (d(f − n))   (1 − n/d when f = inf)
 //   orthographic: z = (d − n) / (f − n)
 // stored as s = z (float, unorm24, unorm16) or s = 1 − z (float-reversed,

@@ -18,15 +18,22 @@ constexpr uint32_t kOneBits = 0x3F800000u;  // 1.0f: the largest stored float
 
 }  // namespace
 
+DepthEncoding encodingOf(DepthFormat format) {
+  switch (format) {
+    case DepthFormat::FloatReversed:
+      return DepthEncoding::FloatReversed;
+    case DepthFormat::Float:
+      return DepthEncoding::Float;
+    case DepthFormat::Unorm24:
+      return DepthEncoding::Unorm24;
+    case DepthFormat::Unorm16:
+      return DepthEncoding::Unorm16;
+  }
+  return DepthEncoding::FloatReversed;
+}
+
 double windowDepth(DepthFormat format, Projection projection, double znear, double zfar, double d) {
-  double z;
-  if (projection == Projection::Orthographic)
-    z = (d - znear) / (zfar - znear);
-  else if (std::isinf(zfar))
-    z = 1.0 - znear / d;
-  else
-    z = zfar * (d - znear) / (d * (zfar - znear));
-  return isReversed(format) ? 1.0 - z : z;
+  return storedWindowDepth(encodingOf(format), projection, znear, zfar, d);
 }
 
 uint32_t depthKey(DepthFormat format, double z) {
@@ -45,20 +52,7 @@ uint32_t depthKey(DepthFormat format, double z) {
 }
 
 double minimumResolvableDifference(DepthFormat format, double maxZ) {
-  switch (format) {
-    case DepthFormat::Unorm24:
-      return std::ldexp(1.0, -24);
-    case DepthFormat::Unorm16:
-      return std::ldexp(1.0, -16);
-    case DepthFormat::Float:
-    case DepthFormat::FloatReversed: {
-      if (!(maxZ > 0.0)) return std::ldexp(1.0, -149);  // zero: the smallest denormal step
-      int e;
-      std::frexp(maxZ, &e);  // maxZ = m·2^e, m in [0.5, 1): IEEE exponent e − 1
-      return std::ldexp(1.0, (e - 1) - 23);
-    }
-  }
-  return 0.0;
+  return depthStep(encodingOf(format), maxZ > 0.0 ? maxZ : 0.0);  // NaN, negative: the smallest step
 }
 
 double polygonOffset(DepthFormat format, double factor, double units, double maxSlope, double maxZ) {

@@ -1,21 +1,26 @@
 // Depth formats, depth keys and polygon offset.
 //
-// Every format stores a window depth z in [0, 1] computed from the view
-// depth d (znear n, zfar f; f may be +inf for perspective):
-//   conventional (Float, Unorm24, Unorm16): perspective z = f(d − n) / (d(f − n)),
+// Every format stores a window depth in [0, 1] computed from the view
+// depth d (znear n, zfar f; f may be +inf for perspective) by the shared
+// formulas of common/depth_formula.h, which the compare tool uses too:
+//   conventional (Float, Unorm24, Unorm16): z = f(d − n) / (d(f − n)),
 //     i.e. 1 − n/d for f = inf; orthographic z = (d − n) / (f − n). Near 0, far 1.
-//   FloatReversed: 1 − the conventional z (near 1, far 0), the default.
-// z/w is affine in screen space, so z is interpolated linearly over the
-// screen from the vertices (in double) and only then rounded to the format.
+//   FloatReversed (the default): s = 1 − z (near 1, far 0), computed
+//     directly as n(f − d) / (d(f − n)), n/d for f = inf, (f − d) / (f − n)
+//     ortho, so it keeps relative precision where 1 − z would cancel.
+// The stored value is affine in screen space, so it is interpolated
+// linearly over the screen from the vertices (in double) and only then
+// rounded to the format.
 //
 // Precision (the smallest step the buffer can tell apart, at view depth d):
 //   Unorm16: 2^-16 in z, ≈ d²/n · 2^-16 in view depth (perspective, f = inf).
 //   Unorm24: 2^-24 in z, ≈ d²/n · 2^-24.
 //   Float:   z near 1 has ULP 2^-24, the same as unorm24 far from the camera,
 //            and far better only near the near plane, where z is small.
-//   FloatReversed: z ≈ n/d is small far away, where float's exponent gives
-//            relative precision 2^-24 in z, i.e. ≈ d · 2^-24 in view depth:
-//            nearly constant relative precision at every distance.
+//   FloatReversed: s ≈ n/d is small far away, where float's exponent gives
+//            relative precision 2^-24 in s, i.e. ≈ d · 2^-24 in view depth:
+//            nearly constant relative precision at every distance (the
+//            double-precision s before rounding is good to ≈ 2^-51 relative).
 // Orthographic z is linear in d, so the steps are (f − n) times the above.
 //
 // The raster stages compare *depth keys*: a uint32 per format where a
@@ -26,13 +31,18 @@
 
 #include <cstdint>
 
+#include "common/depth_formula.h"
 #include "raster/rasterizer.h"
 
 namespace rastray {
 
 constexpr uint32_t kClearDepthKey = 0xFFFFFFFFu;
 
-// Window depth z in [0, 1] of view depth d in `format` (see above).
+// The shared encoding of a format (common/depth_formula.h).
+DepthEncoding encodingOf(DepthFormat format);
+
+// Window depth of view depth d as `format` stores it (z, or s reversed; see
+// above), before clamping and rounding.
 double windowDepth(DepthFormat format, Projection projection, double znear, double zfar, double d);
 
 // The key stored for window depth z (clamped to [0, 1] first, as GL clamps).
@@ -42,9 +52,10 @@ uint32_t depthKey(DepthFormat format, double z);
 inline bool isReversed(DepthFormat format) { return format == DepthFormat::FloatReversed; }
 
 // glPolygonOffset's r: the smallest difference the format resolves for a
-// primitive whose largest window depth is maxZ: 2^-bits for unorm (as the
-// brief fixes it), 2^(e − 23) for float with e the exponent of maxZ
-// (OpenGL 4.6 §14.6.5).
+// primitive whose largest window depth is maxZ: 2^-bits for unorm (the
+// format's own step), 2^(e − 23) for float with e the exponent of maxZ
+// (OpenGL 4.6 §14.6.5; 2^-149 below 2^-126): depthStep of
+// common/depth_formula.h.
 double minimumResolvableDifference(DepthFormat format, double maxZ);
 
 // The offset to add to window depth *away from the viewer* (positive
