@@ -1,4 +1,4 @@
-// Hidden-line wireframe (lecture 003's depth-buffer tricks): the edges of
+// Hidden-line wireframe, drawn with the depth buffer: the edges of
 // the original triangles (not the internal edges of clipped pieces) drawn
 // as 1-pixel lines over the shaded image. A line pixel is hidden when the
 // surface in the depth buffer (centre sample) is nearer than the line,
