@@ -1,7 +1,9 @@
 #include "app/render_setup.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <iterator>
 
 #include "common/error.h"
 #include "common/sampling.h"
@@ -39,50 +41,182 @@ const char* toString(RendererKind kind) {
   return "?";
 }
 
+namespace {
+
+constexpr RendererKind kRendererKinds[] = {RendererKind::Raster, RendererKind::Raytrace,
+                                           RendererKind::Hybrid};
+constexpr RendererSet kRaster = rendererBit(RendererKind::Raster);
+constexpr RendererSet kRaytrace = rendererBit(RendererKind::Raytrace);
+constexpr RendererSet kHybrid = rendererBit(RendererKind::Hybrid);
+// Rasterized primary visibility: the rasterizer alone and hybrid.
+constexpr RendererSet kRasterized = kRaster | kHybrid;
+// Traced rays beyond the primary hit (secondary and shadow rays): the ray
+// caster and hybrid; the rasterizer alone traces none.
+constexpr RendererSet kTraced = kRaytrace | kHybrid;
+
+const char* toString(ShadowMode mode) {
+  switch (mode) {
+    case ShadowMode::None:
+      return "none";
+    case ShadowMode::Map:
+      return "map";
+    case ShadowMode::Rays:
+      return "rays";
+  }
+  return "?";
+}
+
+// "raster", "raster and hybrid", "raster, raytrace and hybrid".
+std::string describeRenderers(RendererSet set) {
+  std::vector<std::string> names;
+  for (RendererKind kind : kRendererKinds)
+    if (set & rendererBit(kind)) names.push_back(toString(kind));
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  return out;
+}
+
+// Registration of one table row: binds the option to its field of `s`.
+#define RASTRAY_BIND(...)                                                                                  \
+  [](CLI::App& cmd, RenderSettings& s, const std::string& name, const std::string& help) -> CLI::Option* { \
+    return __VA_ARGS__;                                                                                    \
+  }
+
+const std::vector<RenderOptionSpec> kRenderOptions = {
+    // Camera (SPEC §2): registered by CameraOptions, shared with info and compare.
+    {"--eye", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
+    {"--target", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
+    {"--up", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
+    {"--yfov", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
+    {"--znear", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
+    {"--zfar", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
+    {"--size", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
+    // Every renderer.
+    {"--spp", kAllRenderers, OptionCondition::Always, "Samples per pixel",
+     RASTRAY_BIND(cmd.add_option(name, s.spp, help + ": " + supportedSampleCounts())->capture_default_str())},
+    {"--threads", kAllRenderers, OptionCondition::Always, "Worker threads (0: all cores)",
+     RASTRAY_BIND(cmd.add_option(name, s.threads, help)->check(CLI::Range(0, 1024)))},
+    {"--debug-pixel", kAllRenderers, OptionCondition::Always,
+     "Trace what each stage did at pixel X Y (stderr)",
+     RASTRAY_BIND(cmd.add_option(name, s.debugPixelXY, help)->expected(2))},
+    {"--texture-filter", kAllRenderers, OptionCondition::Always,
+     "sampler (as the file says), nearest, bilinear or trilinear",
+     RASTRAY_BIND(cmd.add_option(name, s.textureFilter, help)->capture_default_str())},
+    {"--cull", kAllRenderers, OptionCondition::Always, "Cull single-sided triangles: back, front or none",
+     RASTRAY_BIND(cmd.add_option(name, s.cull, help)->capture_default_str())},
+    {"--shadows", kAllRenderers, OptionCondition::Always,
+     "map (shadow maps: raster, hybrid), rays (raytrace, hybrid) or none (raster, hybrid); default map, "
+     "rays for raytrace and hybrid",
+     RASTRAY_BIND(cmd.add_option(name, s.shadows, help))},
+    // Rasterized primary visibility.
+    {"--depth-format", kRasterized, OptionCondition::Always, "float-reversed, float, unorm24 or unorm16",
+     RASTRAY_BIND(cmd.add_option(name, s.depthFormat, help)->capture_default_str())},
+    {"--depth-func", kRasterized, OptionCondition::Always, "less or lequal",
+     RASTRAY_BIND(cmd.add_option(name, s.depthFunc, help)->capture_default_str())},
+    {"--polygon-offset", kRasterized, OptionCondition::Always, "FACTOR UNITS, as glPolygonOffset",
+     RASTRAY_BIND(cmd.add_option(name, s.polygonOffset, help)->expected(2))},
+    {"--transparency", kRasterized, OptionCondition::Always,
+     "sorted, peel:N or exact (per-sample fragment lists)",
+     RASTRAY_BIND(cmd.add_option(name, s.transparency, help)->capture_default_str())},
+    {"--shading-rate", kRasterized, OptionCondition::Always,
+     "sample (shade every sample) or pixel (once per pixel and triangle, as MSAA)",
+     RASTRAY_BIND(cmd.add_option(name, s.shadingRate, help)->capture_default_str())},
+    {"--wireframe", kRasterized, OptionCondition::Always, "Draw visible triangle edges over the image",
+     RASTRAY_BIND(cmd.add_flag(name, s.raster.wireframe, help))},
+    {"--halo", kRasterized, OptionCondition::Wireframe, "Gap each edge where a nearer edge crosses it",
+     RASTRAY_BIND(cmd.add_flag(name, s.raster.halo, help))},
+    {"--shadow-map-size", kRasterized, OptionCondition::ShadowMaps, "Shadow map resolution",
+     RASTRAY_BIND(cmd.add_option(name, s.raster.shadowMapSize, help)
+                      ->check(CLI::Range(16, 16384))
+                      ->capture_default_str())},
+    {"--shadow-bias", kRasterized, OptionCondition::ShadowMaps, "CONSTANT SLOPE shadow-map depth bias",
+     RASTRAY_BIND(cmd.add_option(name, s.shadowBias, help)->expected(2))},
+    // Traced rays.
+    {"--max-depth", kTraced, OptionCondition::Always, "Deepest secondary ray (reflection/refraction)",
+     RASTRAY_BIND(
+         cmd.add_option(name, s.shading.maxDepth, help)->check(CLI::Range(0, 64))->capture_default_str())},
+    {"--transparency-cutoff", kTraced, OptionCondition::Always,
+     "Stop compositing along a ray once the remaining transmittance is below this",
+     RASTRAY_BIND(cmd.add_option(name, s.ray.transparencyCutoff, help)
+                      ->check(CLI::Range(0.0, 1.0))
+                      ->capture_default_str())},
+    // Traced primary rays.
+    {"--no-packets", kRaytrace, OptionCondition::Always,
+     "Trace primary rays one by one instead of in coherent packets",
+     RASTRAY_BIND(cmd.add_flag("!" + name, s.ray.packets, help))},
+};
+
+#undef RASTRAY_BIND
+
+}  // namespace
+
+const std::vector<RenderOptionSpec>& renderOptionTable() { return kRenderOptions; }
+
+std::string describeWhereApplies(const RenderOptionSpec& spec) {
+  std::string out = describeRenderers(spec.renderers);
+  switch (spec.condition) {
+    case OptionCondition::Always:
+      break;
+    case OptionCondition::ShadowMaps:
+      out += " with --shadows map";
+      break;
+    case OptionCondition::Wireframe:
+      out += " with --wireframe";
+      break;
+  }
+  return out;
+}
+
 void addRenderSettings(CLI::App& cmd, RenderSettings& s, bool withRenderer) {
+  const size_t existing = cmd.get_options().size();
+  s.allRenderers = !withRenderer;
   if (withRenderer)
     cmd.add_option("--renderer", s.rendererName,
                    "raster, raytrace or hybrid (rasterized primary visibility, traced "
                    "shadow/reflection/refraction rays)")
         ->capture_default_str();
-  cmd.add_option("--spp", s.spp, "Samples per pixel: " + supportedSampleCounts())->capture_default_str();
   s.camera.addTo(cmd);
-  cmd.add_option("--threads", s.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
-  cmd.add_option("--debug-pixel", s.debugPixelXY, "Trace what each stage did at pixel X Y (stderr)")
-      ->expected(2);
-  cmd.add_option("--texture-filter", s.textureFilter,
-                 "sampler (as the file says), nearest, bilinear or trilinear")
-      ->capture_default_str();
-  cmd.add_option("--max-depth", s.shading.maxDepth, "Deepest secondary ray (reflection/refraction)")
-      ->check(CLI::Range(0, 64))
-      ->capture_default_str();
-  // Rasterizer.
-  cmd.add_option("--cull", s.cull, "Cull single-sided triangles: back, front or none")->capture_default_str();
-  cmd.add_option("--depth-format", s.depthFormat, "float-reversed, float, unorm24 or unorm16")
-      ->capture_default_str();
-  cmd.add_option("--depth-func", s.depthFunc, "less or lequal")->capture_default_str();
-  cmd.add_option("--polygon-offset", s.polygonOffset, "FACTOR UNITS, as glPolygonOffset")->expected(2);
-  cmd.add_option("--transparency", s.transparency, "sorted, peel:N or exact (per-sample fragment lists)")
-      ->capture_default_str();
-  cmd.add_option("--shadows", s.shadows,
-                 "map (shadow maps), rays (hybrid) or none; default map, rays for hybrid");
-  cmd.add_option("--shadow-map-size", s.raster.shadowMapSize, "Shadow map resolution")
-      ->check(CLI::Range(16, 16384))
-      ->capture_default_str();
-  cmd.add_option("--shadow-bias", s.shadowBias, "CONSTANT SLOPE shadow-map depth bias")->expected(2);
-  cmd.add_option("--shading-rate", s.shadingRate,
-                 "sample (shade every sample) or pixel (once per pixel and "
-                 "triangle, as MSAA)")
-      ->capture_default_str();
-  cmd.add_flag("--wireframe", s.raster.wireframe, "Draw visible triangle edges over the image");
-  cmd.add_flag("--halo", s.raster.halo, "With --wireframe: gap each edge where a nearer edge crosses it");
-  // Ray caster.
-  cmd.add_option("--transparency-cutoff", s.ray.transparencyCutoff,
-                 "Stop compositing along a ray once the remaining transmittance is below this")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  cmd.add_flag("!--no-packets", s.ray.packets,
-               "Trace primary rays one by one instead of in coherent packets");
+  s.cliOptions.clear();
+  for (const RenderOptionSpec& spec : kRenderOptions) {
+    if (!spec.add) {
+      s.cliOptions.push_back(cmd.get_option(spec.name));
+      continue;
+    }
+    std::string help = spec.help;
+    if (spec.renderers != kAllRenderers || spec.condition != OptionCondition::Always)
+      help += " [" + describeWhereApplies(spec) + "]";
+    s.cliOptions.push_back(spec.add(cmd, s, spec.name, help));
+  }
+  // Where an option applies is never left unsaid: every option registered
+  // here but --renderer has a row.
+  const auto options = cmd.get_options();
+  for (size_t i = existing; i < options.size(); ++i) {
+    const bool listed =
+        std::any_of(kRenderOptions.begin(), kRenderOptions.end(),
+                    [&](const RenderOptionSpec& spec) { return options[i]->check_name(spec.name); });
+    RASTRAY_CHECK(listed || options[i]->check_name("--renderer"),
+                  options[i]->get_name() + " has no row in the render-option table");
+  }
+}
+
+ShadowMode RenderSettings::shadowModeFor(RendererKind kind) const {
+  if (kind == RendererKind::Raytrace) return ShadowMode::Rays;
+  if (kind == RendererKind::Hybrid && allRenderers) return ShadowMode::Rays;
+  return raster.shadows;
+}
+
+bool RenderSettings::applies(const RenderOptionSpec& spec, RendererKind kind) const {
+  if (!(spec.renderers & rendererBit(kind))) return false;
+  switch (spec.condition) {
+    case OptionCondition::Always:
+      return true;
+    case OptionCondition::ShadowMaps:
+      return shadowModeFor(kind) == ShadowMode::Map;
+    case OptionCondition::Wireframe:
+      return raster.wireframe;
+  }
+  return false;
 }
 
 void RenderSettings::finish() {
@@ -131,22 +265,29 @@ void RenderSettings::finish() {
   } else {
     badOption("--transparency", "'" + transparency + "' is not one of sorted, peel:N, exact");
   }
-  const std::string shadowName =
-      shadows.empty() ? (renderer == RendererKind::Hybrid ? "rays" : "map") : shadows;
-  raster.shadows =
-      pick<ShadowMode>("--shadows", shadowName,
+
+  // Shadows: map and none need the rasterizer, rays a ray tracer (the ray
+  // caster traces shadow rays always). raster.shadows is the rasterizer's
+  // technique; with allRenderers, that of the rasterizer alone.
+  const bool shadowsGiven = !shadows.empty();
+  const RendererKind rasterizing = allRenderers ? RendererKind::Raster : renderer;
+  const ShadowMode shadowMode =
+      pick<ShadowMode>("--shadows",
+                       shadowsGiven                          ? shadows
+                       : rasterizing == RendererKind::Raster ? "map"
+                                                             : "rays",
                        {{"map", ShadowMode::Map}, {"rays", ShadowMode::Rays}, {"none", ShadowMode::None}});
-  if (raster.shadows == ShadowMode::Rays && renderer == RendererKind::Raster)
-    badOption("--shadows", "'rays' needs --renderer hybrid or raytrace");
-  if (renderer == RendererKind::Raytrace && raster.shadows == ShadowMode::Map && !shadows.empty())
-    badOption("--shadows", "shadow maps are a rasterizer technique; the ray caster traces shadow rays");
+  const RendererSet shadowModeRenderers = shadowMode == ShadowMode::Rays ? kTraced : kRasterized;
+  if (!allRenderers && !(shadowModeRenderers & rendererBit(renderer)))
+    badOption("--shadows", "'" + shadows + "' applies to " + describeRenderers(shadowModeRenderers) +
+                               ", not to --renderer " + toString(renderer));
+  raster.shadows = allRenderers && shadowMode == ShadowMode::Rays ? ShadowMode::Map : shadowMode;
   if (!shadowBias.empty()) {
     raster.shadowBiasConstant = shadowBias[0];
     raster.shadowBiasSlope = shadowBias[1];
   }
   raster.shadingRate = pick<ShadingRate>("--shading-rate", shadingRate,
                                          {{"sample", ShadingRate::Sample}, {"pixel", ShadingRate::Pixel}});
-  if (raster.halo && !raster.wireframe) badOption("--halo", "needs --wireframe");
   raster.shading = shading;
   raster.debugPixel = debugPixel;
   raster.keepSamples = keepSamples;
@@ -156,14 +297,27 @@ void RenderSettings::finish() {
   ray.debugPixel = debugPixel;
   ray.keepSamples = keepSamples;
 
-  if (renderer == RendererKind::Raytrace) {
-    // Rasterizer-only options are refused rather than silently ignored.
-    if (cull != "none") badOption("--cull", "applies to the rasterizer (raster, hybrid) only");
-    if (depthFormat != "float-reversed") badOption("--depth-format", "applies to the rasterizer only");
-    if (depthFunc != "less") badOption("--depth-func", "applies to the rasterizer only");
-    if (!polygonOffset.empty()) badOption("--polygon-offset", "applies to the rasterizer only");
-    if (transparency != "exact") badOption("--transparency", "the ray caster always composites exactly");
-    if (raster.wireframe) badOption("--wireframe", "applies to the rasterizer only");
+  // Options given where they do not apply are refused, not ignored; given
+  // means given (count()), so the default value given to the wrong
+  // renderer is refused too.
+  for (size_t i = 0; i < kRenderOptions.size() && i < cliOptions.size(); ++i) {
+    const RenderOptionSpec& spec = kRenderOptions[i];
+    if (!cliOptions[i] || cliOptions[i]->count() == 0) continue;
+    const std::string where = "applies to " + describeWhereApplies(spec);
+    if (allRenderers) {
+      if (std::none_of(std::begin(kRendererKinds), std::end(kRendererKinds),
+                       [&](RendererKind kind) { return applies(spec, kind); }))
+        badOption(spec.name, where + ", and none of the renderers here " +
+                                 (spec.condition == OptionCondition::ShadowMaps ? "uses shadow maps"
+                                                                                : "draws a wireframe"));
+    } else if (!applies(spec, renderer)) {
+      std::string context;
+      if (spec.renderers & rendererBit(renderer))
+        context = spec.condition == OptionCondition::ShadowMaps
+                      ? std::string(" with --shadows ") + toString(shadowModeFor(renderer))
+                      : std::string(" without --wireframe");
+      badOption(spec.name, where + ", not to --renderer " + toString(renderer) + context);
+    }
   }
 }
 
@@ -185,13 +339,13 @@ RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
       run.output = renderRaster(scene, run.analysis, run.camera, raster);
       break;
     case RendererKind::Raytrace: {
-      RayCaster caster(scene, run.analysis);
+      RayCaster caster(scene, run.analysis, raster.cull);
       caster.bind(run.camera, ray);
       run.output = caster.render();
       break;
     }
     case RendererKind::Hybrid: {
-      RayCaster caster(scene, run.analysis);
+      RayCaster caster(scene, run.analysis, raster.cull);
       caster.bind(run.camera, ray);
       const bool traced = raster.shadows == ShadowMode::Rays;
       run.output = renderRaster(scene, run.analysis, run.camera, raster, &caster, traced ? &caster : nullptr);

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -22,6 +23,38 @@ namespace rastray {
 
 enum class RendererKind { Raster, Raytrace, Hybrid };
 const char* toString(RendererKind kind);
+
+// A set of renderers, one bit per RendererKind.
+using RendererSet = unsigned;
+constexpr RendererSet rendererBit(RendererKind kind) { return 1u << unsigned(kind); }
+constexpr RendererSet kAllRenderers = 0b111;
+
+// Within its renderers, when an option applies.
+enum class OptionCondition {
+  Always,
+  ShadowMaps,  // the renderer uses shadow maps (--shadows map)
+  Wireframe,   // --wireframe is given
+};
+
+struct RenderSettings;
+
+// One row of the render-option table: every option addRenderSettings
+// registers has one, and the table alone decides both the registration and
+// the refusal of an option the user gave where it does not apply.
+struct RenderOptionSpec {
+  const char* name;  // "--shadow-map-size"
+  RendererSet renderers;
+  OptionCondition condition;
+  const char* help;  // nullptr: a camera option, registered with its help by CameraOptions
+  // Registers the option bound to its field of `s`; nullptr for camera options.
+  CLI::Option* (*add)(CLI::App& cmd, RenderSettings& s, const std::string& name, const std::string& help);
+  const char* example;  // a value every renderer it applies to accepts ("" for flags)
+};
+
+// The table, in --help order.
+const std::vector<RenderOptionSpec>& renderOptionTable();
+// "raster and hybrid with --shadows map": where an option applies.
+std::string describeWhereApplies(const RenderOptionSpec& spec);
 
 struct RenderSettings {
   RendererKind renderer = RendererKind::Raster;
@@ -43,12 +76,28 @@ struct RenderSettings {
   std::vector<float> polygonOffset, shadowBias;
   std::vector<int> debugPixelXY;
 
+  // Set by addRenderSettings: each table row's CLI option (its count()
+  // tells whether the user gave it), and whether the command runs every
+  // renderer (crossval, explain) rather than the one --renderer names.
+  std::vector<const CLI::Option*> cliOptions;
+  bool allRenderers = false;
+
   // Validates combinations and fills the option structures; throws
-  // InputError("command line", option, message).
+  // InputError("command line", option, message). An option the user gave
+  // must apply to the chosen renderer (with allRenderers: to at least one
+  // of them), even when the value given is its default.
   void finish();
+
+  // Whether a table row applies to `kind` under these settings (after
+  // finish()). With allRenderers, hybrid traces shadow rays whatever
+  // --shadows says: crossval compares its colours with the ray caster's.
+  bool applies(const RenderOptionSpec& spec, RendererKind kind) const;
+  // The shadow technique `kind` uses under these settings (after finish()).
+  ShadowMode shadowModeFor(RendererKind kind) const;
 };
 
-// `withRenderer`: whether --renderer is an option (crossval runs all three).
+// Registers --renderer (when `withRenderer`; crossval and explain run every
+// renderer), the camera options and every row of renderOptionTable().
 void addRenderSettings(CLI::App& cmd, RenderSettings& settings, bool withRenderer = true);
 
 struct RenderRun {

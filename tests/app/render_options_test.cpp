@@ -1,0 +1,321 @@
+// Render options that do not apply to the chosen renderer are refused
+// (exit 2), not ignored: the render-option table in app/render_setup.cpp
+// against an independent list of where each option applies, enforced by
+// RenderSettings::finish() and by the real binary.
+#ifdef RASTRAY_HAVE_RENDERERS
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "app/render_setup.h"
+#include "common/error.h"
+#include "run_command.h"
+
+namespace rastray {
+namespace {
+
+using test::runRastray;
+using Args = std::vector<std::string>;
+
+constexpr RendererKind kKinds[] = {RendererKind::Raster, RendererKind::Raytrace, RendererKind::Hybrid};
+constexpr RendererSet kRaster = rendererBit(RendererKind::Raster);
+constexpr RendererSet kRaytrace = rendererBit(RendererKind::Raytrace);
+constexpr RendererSet kHybrid = rendererBit(RendererKind::Hybrid);
+
+const std::string kScene = std::string(RASTRAY_SCENES) + "/three-triangles.gltf";
+
+// Where each option applies (issue 8, README `rastray render`), written
+// out apart from the table so that a wrong row fails; with a value each
+// renderer it applies to accepts.
+struct Expected {
+  const char* name;
+  RendererSet renderers;
+  OptionCondition condition;
+  Args value;
+};
+
+const std::vector<Expected> kExpected = {
+    {"--eye", kAllRenderers, OptionCondition::Always, {"0", "0", "3"}},
+    {"--target", kAllRenderers, OptionCondition::Always, {"0", "0", "0"}},
+    {"--up", kAllRenderers, OptionCondition::Always, {"0", "1", "0"}},
+    {"--yfov", kAllRenderers, OptionCondition::Always, {"40"}},
+    {"--znear", kAllRenderers, OptionCondition::Always, {"0.1"}},
+    {"--zfar", kAllRenderers, OptionCondition::Always, {"100"}},
+    {"--size", kAllRenderers, OptionCondition::Always, {"8", "6"}},
+    {"--spp", kAllRenderers, OptionCondition::Always, {"4"}},
+    {"--threads", kAllRenderers, OptionCondition::Always, {"1"}},
+    {"--debug-pixel", kAllRenderers, OptionCondition::Always, {"1", "1"}},
+    {"--texture-filter", kAllRenderers, OptionCondition::Always, {"nearest"}},
+    {"--cull", kAllRenderers, OptionCondition::Always, {"back"}},
+    {"--shadows", kAllRenderers, OptionCondition::Always, {}},  // value: see valueFor
+    {"--depth-format", kRaster | kHybrid, OptionCondition::Always, {"float"}},
+    {"--depth-func", kRaster | kHybrid, OptionCondition::Always, {"lequal"}},
+    {"--polygon-offset", kRaster | kHybrid, OptionCondition::Always, {"1", "1"}},
+    {"--transparency", kRaster | kHybrid, OptionCondition::Always, {"sorted"}},
+    {"--shading-rate", kRaster | kHybrid, OptionCondition::Always, {"pixel"}},
+    {"--wireframe", kRaster | kHybrid, OptionCondition::Always, {}},
+    {"--halo", kRaster | kHybrid, OptionCondition::Wireframe, {}},
+    {"--shadow-map-size", kRaster | kHybrid, OptionCondition::ShadowMaps, {"64"}},
+    {"--shadow-bias", kRaster | kHybrid, OptionCondition::ShadowMaps, {"1", "1"}},
+    {"--max-depth", kRaytrace | kHybrid, OptionCondition::Always, {"2"}},
+    {"--transparency-cutoff", kRaytrace | kHybrid, OptionCondition::Always, {"0.01"}},
+    {"--no-packets", kRaytrace, OptionCondition::Always, {}},
+};
+
+const Expected& expected(const std::string& name) {
+  for (const Expected& e : kExpected)
+    if (name == e.name) return e;
+  throw std::runtime_error(name + ": not in the test's list of options");
+}
+
+// The option and a value `kind` accepts.
+Args valueFor(const std::string& name, RendererKind kind) {
+  Args args = {name};
+  if (name == "--shadows") {
+    args.push_back(kind == RendererKind::Raster ? "none" : "rays");
+  } else {
+    const Args& v = expected(name).value;
+    args.insert(args.end(), v.begin(), v.end());
+  }
+  return args;
+}
+
+// What makes a conditional option apply, and what makes it not apply.
+Args conditionMet(OptionCondition c) {
+  switch (c) {
+    case OptionCondition::Always:
+      return {};
+    case OptionCondition::ShadowMaps:
+      return {"--shadows", "map"};
+    case OptionCondition::Wireframe:
+      return {"--wireframe"};
+  }
+  return {};
+}
+
+Args conditionUnmet(OptionCondition c) {
+  return c == OptionCondition::ShadowMaps ? Args{"--shadows", "none"} : Args{};
+}
+
+Args operator+(Args a, const Args& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+// Parses `args` as `render` (withRenderer) or crossval/explain would and
+// runs finish(): the InputError it threw, if any.
+std::optional<InputError> finishWith(const Args& args, bool withRenderer = true,
+                                     RenderSettings* out = nullptr) {
+  CLI::App app;
+  RenderSettings settings;
+  addRenderSettings(app, settings, withRenderer);
+  Args reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
+  app.parse(reversed);
+  try {
+    settings.finish();
+  } catch (const InputError& e) {
+    return e;
+  }
+  if (out) {
+    *out = settings;
+    out->cliOptions.clear();  // they point into `app`
+  }
+  return std::nullopt;
+}
+
+Args withRenderer(RendererKind kind, const Args& args) { return Args{"--renderer", toString(kind)} + args; }
+
+std::string joined(const Args& args) {
+  std::string s;
+  for (const std::string& a : args) s += " " + a;
+  return s;
+}
+
+TEST(RenderOptionTable, SaysWhereEachOptionApplies) {
+  const auto& table = renderOptionTable();
+  EXPECT_EQ(table.size(), kExpected.size());
+  for (const Expected& e : kExpected) {
+    const auto row = std::find_if(table.begin(), table.end(), [&](const RenderOptionSpec& spec) {
+      return spec.name == std::string(e.name);
+    });
+    ASSERT_NE(row, table.end()) << e.name << " has no row";
+    EXPECT_EQ(row->renderers, e.renderers) << e.name << ": table says " << describeWhereApplies(*row);
+    EXPECT_EQ(row->condition, e.condition) << e.name << ": table says " << describeWhereApplies(*row);
+  }
+}
+
+TEST(RenderOptionTable, DrivesTheRegistration) {
+  CLI::App app;
+  RenderSettings settings;
+  addRenderSettings(app, settings);
+  ASSERT_EQ(settings.cliOptions.size(), renderOptionTable().size());
+  for (size_t i = 0; i < settings.cliOptions.size(); ++i) {
+    ASSERT_NE(settings.cliOptions[i], nullptr) << renderOptionTable()[i].name;
+    EXPECT_TRUE(settings.cliOptions[i]->check_name(renderOptionTable()[i].name));
+  }
+  // --help says where an option applies.
+  const std::string help = app.help();
+  EXPECT_NE(help.find("[raster and hybrid with --shadows map]"), std::string::npos) << help;
+  EXPECT_NE(help.find("[raytrace]"), std::string::npos) << help;
+}
+
+TEST(RenderOptions, RefusedForRenderersTheyDoNotApplyTo) {
+  int refusals = 0;
+  for (const RenderOptionSpec& spec : renderOptionTable())
+    for (RendererKind kind : kKinds) {
+      if (spec.renderers & rendererBit(kind)) continue;
+      const Args args = withRenderer(kind, valueFor(spec.name, kind));
+      const auto error = finishWith(args);
+      ASSERT_TRUE(error) << "accepted:" << joined(args);
+      EXPECT_EQ(error->element(), spec.name) << error->what();
+      EXPECT_EQ(error->message(),
+                "applies to " + describeWhereApplies(spec) + ", not to --renderer " + toString(kind));
+      ++refusals;
+    }
+  EXPECT_GE(refusals, 12);
+}
+
+TEST(RenderOptions, RefusedWhereTheirConditionDoesNotHold) {
+  int refusals = 0;
+  for (const RenderOptionSpec& spec : renderOptionTable()) {
+    if (spec.condition == OptionCondition::Always) continue;
+    for (RendererKind kind : kKinds) {
+      if (!(spec.renderers & rendererBit(kind))) continue;
+      const Args args = withRenderer(kind, conditionUnmet(spec.condition) + valueFor(spec.name, kind));
+      const auto error = finishWith(args);
+      ASSERT_TRUE(error) << "accepted:" << joined(args);
+      EXPECT_EQ(error->element(), spec.name) << error->what();
+      EXPECT_NE(error->message().find(std::string("not to --renderer ") + toString(kind)), std::string::npos)
+          << error->what();
+      ++refusals;
+    }
+  }
+  EXPECT_EQ(refusals, 6);
+  // Hybrid traces shadow rays unless told otherwise: no shadow maps.
+  const auto error = finishWith({"--renderer", "hybrid", "--shadow-bias", "1", "1"});
+  ASSERT_TRUE(error);
+  EXPECT_EQ(std::string(error->what()),
+            "command line: --shadow-bias: applies to raster and hybrid with --shadows map, not to --renderer "
+            "hybrid with --shadows rays");
+  // The rasterizer uses shadow maps unless told otherwise.
+  EXPECT_FALSE(finishWith({"--renderer", "raster", "--shadow-map-size", "64"}));
+}
+
+TEST(RenderOptions, AcceptedWhereTheyApply) {
+  for (const RenderOptionSpec& spec : renderOptionTable())
+    for (RendererKind kind : kKinds) {
+      if (!(spec.renderers & rendererBit(kind))) continue;
+      const Args args = withRenderer(kind, conditionMet(spec.condition) + valueFor(spec.name, kind));
+      const auto error = finishWith(args);
+      EXPECT_FALSE(error) << joined(args) << ": " << error->what();
+    }
+}
+
+// Given means given: the default value to the wrong renderer is refused.
+TEST(RenderOptions, DefaultValueGivenToTheWrongRendererIsRefused) {
+  for (const Args& args : {Args{"--renderer", "raytrace", "--depth-format", "float-reversed"},
+                           Args{"--renderer", "raytrace", "--transparency", "exact"},
+                           Args{"--renderer", "raster", "--max-depth", "8"},
+                           Args{"--renderer", "raster", "--transparency-cutoff", "0.0001"},
+                           Args{"--renderer", "hybrid", "--shadow-map-size", "2048"}}) {
+    const auto error = finishWith(args);
+    ASSERT_TRUE(error) << "accepted:" << joined(args);
+    EXPECT_EQ(error->element(), args[2]);
+  }
+}
+
+TEST(RenderOptions, ShadowTechniquesPerRenderer) {
+  struct Case {
+    const char* renderer;
+    const char* shadows;
+    bool accepted;
+  };
+  for (const Case& c :
+       {Case{"raster", "map", true}, Case{"raster", "none", true}, Case{"raster", "rays", false},
+        Case{"raytrace", "rays", true}, Case{"raytrace", "map", false}, Case{"raytrace", "none", false},
+        Case{"hybrid", "map", true}, Case{"hybrid", "none", true}, Case{"hybrid", "rays", true}}) {
+    const auto error = finishWith({"--renderer", c.renderer, "--shadows", c.shadows});
+    EXPECT_EQ(!error, c.accepted) << c.renderer << " " << c.shadows;
+    if (error) {
+      EXPECT_EQ(error->element(), "--shadows");
+    }
+  }
+}
+
+// crossval and explain run every renderer: an option applies when it
+// applies to one of them, and goes to those it applies to.
+TEST(RenderOptions, AllRenderersAcceptWhatAppliesToOne) {
+  for (const RenderOptionSpec& spec : renderOptionTable()) {
+    const RendererKind kind = (spec.renderers & kRaster) ? RendererKind::Raster : RendererKind::Raytrace;
+    const Args args = conditionMet(spec.condition) + valueFor(spec.name, kind);
+    const auto error = finishWith(args, /*withRenderer=*/false);
+    EXPECT_FALSE(error) << joined(args) << ": " << error->what();
+  }
+  RenderSettings s;
+  ASSERT_FALSE(finishWith({"--shadows", "rays", "--no-packets"}, false, &s));
+  EXPECT_EQ(s.raster.shadows, ShadowMode::Map);  // the rasterizer alone has no rays
+  EXPECT_EQ(s.shadowModeFor(RendererKind::Hybrid), ShadowMode::Rays);
+  EXPECT_FALSE(s.ray.packets);
+  ASSERT_FALSE(finishWith({"--shadows", "none"}, false, &s));
+  EXPECT_EQ(s.raster.shadows, ShadowMode::None);
+
+  // Refused only when it applies to none of them.
+  auto error = finishWith({"--shadows", "none", "--shadow-map-size", "64"}, false);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->element(), "--shadow-map-size");
+  error = finishWith({"--halo"}, false);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->element(), "--halo");
+}
+
+// Through the real binary: refused before the scene is read, exit 2 and
+// one line naming the option.
+TEST(RenderOptionsCommand, RefusedWhereTheyDoNotApply) {
+  for (const RenderOptionSpec& spec : renderOptionTable())
+    for (RendererKind kind : kKinds) {
+      if (spec.renderers & rendererBit(kind)) continue;
+      const Args args =
+          Args{"render", kScene, "-o", "never-written.png"} + withRenderer(kind, valueFor(spec.name, kind));
+      const auto r = runRastray(args);
+      EXPECT_EQ(r.status, 2) << joined(args) << "\n" << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_EQ(r.err.rfind(std::string("command line: ") + spec.name + ": applies to ", 0), 0u) << r.err;
+    }
+  const auto r = runRastray(
+      {"render", kScene, "-o", "never-written.png", "--renderer", "raytrace", "--shadow-map-size", "64"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(
+      r.err,
+      "command line: --shadow-map-size: applies to raster and hybrid with --shadows map, not to --renderer "
+      "raytrace\n");
+}
+
+TEST(RenderOptionsCommand, AcceptedWhereTheyApply) {
+  for (const Args& args : {Args{"--renderer", "raytrace", "--cull", "back", "--no-packets", "--max-depth",
+                                "2", "--shadows", "rays"},
+                           Args{"--renderer", "hybrid", "--shadows", "map", "--shadow-map-size", "64",
+                                "--transparency-cutoff", "0.1"},
+                           Args{"--renderer", "raster", "--wireframe", "--halo", "--shadow-bias", "1", "1",
+                                "--depth-func", "lequal"}}) {
+    const auto r =
+        runRastray(Args{"render", kScene, "-o", "render-options.png", "--size", "16", "12"} + args);
+    EXPECT_EQ(r.status, 0) << joined(args) << "\n" << r.err;
+  }
+  const auto r = runRastray({"crossval", kScene, "--size", "16", "12", "--no-packets", "--shadow-map-size",
+                             "64", "--depth-format", "float", "--max-depth", "2"});
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  const auto e = runRastray({"explain", kScene, "1", "1", "--size", "16", "12", "--halo"});
+  EXPECT_EQ(e.status, 2) << e.err;
+  EXPECT_EQ(e.err.rfind("command line: --halo: ", 0), 0u) << e.err;
+}
+
+}  // namespace
+}  // namespace rastray
+
+#endif  // RASTRAY_HAVE_RENDERERS
