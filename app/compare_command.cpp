@@ -1,7 +1,9 @@
 // `rastray compare A.exr B.exr`: where two SPEC §6 EXR files (from rastray
 // or any other renderer) disagree about visibility, why, and how far their
 // colours differ. Exit status 1 when a threshold is violated (SPEC §7), so
-// the command can gate a test suite.
+// the command can gate a test suite. Files may hold any subset of the SPEC
+// §6 channels; without colour the colour metrics are skipped, and the
+// colour options (--fail-rms, --heatmap) exit 2.
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -29,6 +31,18 @@ struct CompareCommandOptions {
   std::string heatmap, mismatchMap, depthMap;
 };
 
+// Colour options asked of files without colour (a visibility export) are
+// bad usage, exit 2: --fail-rms would otherwise pass (or fail) a check it
+// never made, and --heatmap would draw a picture of nothing.
+void requireColorFor(const CompareResult& result, const CompareCommandOptions& opt) {
+  if (result.colorSkipped.empty()) return;
+  const char* option = opt.failRmsOption->count() ? "--fail-rms"
+                       : !opt.heatmap.empty()     ? "--heatmap"
+                                                  : nullptr;
+  if (option)
+    throw InputError("command line", option, "cannot apply: colour skipped (" + result.colorSkipped + ")");
+}
+
 int runCompare(const CompareCommandOptions& opt) {
   // Camera options other than the planes only make sense with the scene's
   // camera; silently ignoring them would misstate the classification.
@@ -55,6 +69,7 @@ int runCompare(const CompareCommandOptions& opt) {
   if (opt.minAgreementOption->count()) t.minAgreement = opt.minAgreement;
   if (opt.maxGenuineOption->count()) t.maxGenuine = opt.maxGenuine;
   if (opt.failRmsOption->count()) t.failRms = opt.failRms;
+  requireColorFor(result, opt);
   const std::vector<std::string> violations = thresholdViolations(result, t);
 
   if (!opt.heatmap.empty()) writeDifferenceHeatMap(opt.heatmap, result.colorA, result.colorB);

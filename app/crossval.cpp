@@ -11,17 +11,17 @@ namespace {
 
 // The entries of one sample of one pixel: [begin, end) into samples.
 struct SampleRange {
-  uint32_t begin = 0, end = 0;
+  uint64_t begin = 0, end = 0;
 };
 
 // Splits a pixel's entries (sorted by sample index first) by sample.
 std::vector<SampleRange> splitBySample(const DeepImage& image, size_t pixel, uint32_t spp) {
   std::vector<SampleRange> ranges(spp);
-  uint32_t i = image.offsets[pixel];
-  const uint32_t end = image.offsets[pixel + 1];
+  uint64_t i = image.offsets[pixel];
+  const uint64_t end = image.offsets[pixel + 1];
   while (i < end) {
     const uint32_t s = image.samples[i].sample;
-    uint32_t j = i;
+    uint64_t j = i;
     while (j < end && image.samples[j].sample == s) ++j;
     if (s < spp) ranges[s] = {i, j};
     i = j;

@@ -69,7 +69,7 @@ std::string hitText(const DeepSample* s) {
 // The entries of sample `index` at pixel p, front to back.
 std::vector<const DeepSample*> layersOf(const DeepImage& image, size_t p, uint32_t index) {
   std::vector<const DeepSample*> out;
-  for (uint32_t i = image.offsets[p]; i < image.offsets[p + 1]; ++i)
+  for (uint64_t i = image.offsets[p]; i < image.offsets[p + 1]; ++i)
     if (image.samples[i].sample == index) out.push_back(&image.samples[i]);
   return out;
 }

@@ -37,6 +37,7 @@ const char* const kZ = "Z";
 const char* const kInstance = "id.instance";
 const char* const kTriangle = "id.triangle";
 const char* const kSample = "id.sample";
+const char* const kCutoff = "cutoff";
 
 std::string lowercaseExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -136,14 +137,26 @@ std::unique_ptr<OIIO::ImageInput> openExr(const std::string& path) {
   return in;
 }
 
-int requireChannel(const std::string& path, const OIIO::ImageSpec& spec, const char* name) {
-  const int c = spec.channelindex(name);
-  if (c < 0) {
-    std::string have;
-    for (const std::string& n : spec.channelnames) have += (have.empty() ? "" : " ") + n;
-    throw InputError(path, std::string("channel ") + name, "missing (the file has: " + have + ")");
-  }
-  return c;
+// Where R, G, B and A are (-1: absent). Colour is all of R, G and B or
+// none: a partial set (say R and B) cannot be compared without guessing the
+// missing channel, so it counts as no colour, like a visibility export.
+struct ColorChannels {
+  int r, g, b, a;
+  bool complete() const { return r >= 0 && g >= 0 && b >= 0; }
+};
+
+// Any subset of the SPEC §6 channels is a file we can compare, but a file
+// with none of them (say only "Y", or layers named "beauty.R") would
+// compare as "nothing hit" everywhere: refuse it and list what it has.
+ColorChannels colorChannelsOf(const std::string& path, const OIIO::ImageSpec& spec) {
+  const ColorChannels c{spec.channelindex(kR), spec.channelindex(kG), spec.channelindex(kB),
+                        spec.channelindex(kA)};
+  for (const char* name : {kR, kG, kB, kA, kZ, kInstance, kTriangle})
+    if (spec.channelindex(name) >= 0) return c;
+  std::string have;
+  for (const std::string& n : spec.channelnames) have += (have.empty() ? "" : " ") + n;
+  throw InputError(path, "channels",
+                   "none of R G B A Z id.instance id.triangle (the file has: " + have + ")");
 }
 
 // Where the data window lies in the display window. Our own files have
@@ -366,10 +379,11 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
                     std::to_string(image.samples.size()) + " samples");
 
   // Colour is float, not half: deep files are for sample-exact analysis.
-  OIIO::ImageSpec spec(image.width, image.height, 8, OIIO::TypeFloat);
-  spec.channelnames = {kR, kG, kB, kA, kZ, kInstance, kTriangle, kSample};
-  spec.channelformats = {OIIO::TypeFloat, OIIO::TypeFloat,  OIIO::TypeFloat,  OIIO::TypeFloat,
-                         OIIO::TypeFloat, OIIO::TypeUInt32, OIIO::TypeUInt32, OIIO::TypeUInt32};
+  OIIO::ImageSpec spec(image.width, image.height, 9, OIIO::TypeFloat);
+  spec.channelnames = {kR, kG, kB, kA, kZ, kInstance, kTriangle, kSample, kCutoff};
+  spec.channelformats = {OIIO::TypeFloat,  OIIO::TypeFloat,  OIIO::TypeFloat,
+                         OIIO::TypeFloat,  OIIO::TypeFloat,  OIIO::TypeUInt32,
+                         OIIO::TypeUInt32, OIIO::TypeUInt32, OIIO::TypeUInt32};
   spec.alpha_channel = 3;
   spec.z_channel = 4;
   spec.deep = true;
@@ -379,7 +393,11 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
   std::vector<unsigned int> counts(pixels);
   for (size_t i = 0; i < pixels; ++i) {
     RASTRAY_CHECK(image.offsets[i] <= image.offsets[i + 1], "offsets[" + std::to_string(i) + "] decreases");
-    counts[i] = image.offsets[i + 1] - image.offsets[i];
+    // OpenEXR counts one pixel's samples in 32 bits (the file's total may exceed that).
+    const uint64_t count = image.offsets[i + 1] - image.offsets[i];
+    RASTRAY_CHECK(count <= std::numeric_limits<unsigned int>::max(),
+                  "pixel " + std::to_string(i) + " has " + std::to_string(count) + " deep samples");
+    counts[i] = unsigned(count);
   }
   deep.set_all_samples(counts);
   for (size_t i = 0; i < pixels; ++i) {
@@ -392,6 +410,7 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
       deep.set_deep_value(px, 5, si, d.instance);
       deep.set_deep_value(px, 6, si, d.triangle);
       deep.set_deep_value(px, 7, si, d.sample);
+      deep.set_deep_value(px, 8, si, uint32_t(d.cutOff ? 1 : 0));
     }
   }
   writeAtomically(path, "openexr", spec, [&](OIIO::ImageOutput& out) { return out.write_deep_image(deep); });
@@ -408,10 +427,7 @@ FlatImage readExrUnchecked(const std::string& path) {
   // composites, Z and IDs from the centre sample), which only the caller
   // knows; so we refuse and let the caller use readDeepExr.
   if (spec.deep) throw InputError(path, "", "deep EXR where a flat one is expected");
-  const int cR = requireChannel(path, spec, kR);
-  const int cG = requireChannel(path, spec, kG);
-  const int cB = requireChannel(path, spec, kB);
-  const int cA = spec.channelindex(kA);
+  const ColorChannels cc = colorChannelsOf(path, spec);
   const int cZ = spec.channelindex(kZ);
 
   // One decode in the file's own formats; every channel is then converted
@@ -424,11 +440,14 @@ FlatImage readExrUnchecked(const std::string& path) {
   FlatImage data(spec.width, spec.height);
   const OIIO::stride_t colorStride = sizeof(glm::vec4);
   float* color = &data.color[0][0];
-  convertChannel(spec, native, cR, OIIO::TypeFloat, color + 0, colorStride);
-  convertChannel(spec, native, cG, OIIO::TypeFloat, color + 1, colorStride);
-  convertChannel(spec, native, cB, OIIO::TypeFloat, color + 2, colorStride);
-  if (cA >= 0) {
-    convertChannel(spec, native, cA, OIIO::TypeFloat, color + 3, colorStride);
+  data.hasColor = cc.complete();
+  if (data.hasColor) {
+    convertChannel(spec, native, cc.r, OIIO::TypeFloat, color + 0, colorStride);
+    convertChannel(spec, native, cc.g, OIIO::TypeFloat, color + 1, colorStride);
+    convertChannel(spec, native, cc.b, OIIO::TypeFloat, color + 2, colorStride);
+  }
+  if (cc.a >= 0) {
+    convertChannel(spec, native, cc.a, OIIO::TypeFloat, color + 3, colorStride);
   } else {
     for (glm::vec4& c : data.color) c.a = 1.0f;
   }
@@ -441,6 +460,7 @@ FlatImage readExrUnchecked(const std::string& path) {
     return data;
   }
   FlatImage image(w.width, w.height);
+  image.hasColor = data.hasColor;
   for (int y = std::max(0, w.dataY); y < std::min(w.height, w.dataY + w.dataHeight); ++y) {
     for (int x = std::max(0, w.dataX); x < std::min(w.width, w.dataX + w.dataWidth); ++x) {
       const size_t from = data.index(x - w.dataX, y - w.dataY), to = image.index(x, y);
@@ -457,14 +477,12 @@ DeepImage readDeepExrUnchecked(const std::string& path) {
   std::unique_ptr<OIIO::ImageInput> in = openExr(path);
   const OIIO::ImageSpec spec = in->spec();
   if (!spec.deep) throw InputError(path, "", "flat EXR where a deep one is expected");
-  const int cR = requireChannel(path, spec, kR);
-  const int cG = requireChannel(path, spec, kG);
-  const int cB = requireChannel(path, spec, kB);
-  const int cA = spec.channelindex(kA);
+  const ColorChannels cc = colorChannelsOf(path, spec);
   const int cZ = spec.channelindex(kZ);
   const int cInstance = spec.channelindex(kInstance);
   const int cTriangle = spec.channelindex(kTriangle);
   const int cSample = spec.channelindex(kSample);
+  const int cCutoff = spec.channelindex(kCutoff);
 
   OIIO::DeepData deep;
   if (!in->read_native_deep_image(0, 0, deep)) {
@@ -475,6 +493,7 @@ DeepImage readDeepExrUnchecked(const std::string& path) {
   DeepImage image;
   image.width = w.width;
   image.height = w.height;
+  image.hasColor = cc.complete();
   image.offsets.assign(size_t(w.width) * size_t(w.height) + 1, 0);
   // The data-window pixel that display pixel (x, y) reads, or -1.
   const auto dataPixel = [&](int x, int y) -> int64_t {
@@ -486,11 +505,7 @@ DeepImage readDeepExrUnchecked(const std::string& path) {
     for (int x = 0; x < w.width; ++x) {
       const int64_t px = dataPixel(x, y);
       const size_t i = size_t(y) * size_t(w.width) + size_t(x);
-      const uint64_t total = uint64_t(image.offsets[i]) + uint64_t(px < 0 ? 0 : deep.samples(px));
-      if (total > std::numeric_limits<uint32_t>::max()) {
-        throw InputError(path, "", "more than 2^32 - 1 deep samples");
-      }
-      image.offsets[i + 1] = uint32_t(total);
+      image.offsets[i + 1] = image.offsets[i] + uint64_t(px < 0 ? 0 : deep.samples(px));
     }
   }
   image.samples.resize(image.offsets.back());
@@ -503,13 +518,17 @@ DeepImage readDeepExrUnchecked(const std::string& path) {
       const int n = deep.samples(px);
       for (int s = 0; s < n; ++s) {
         DeepSample& d = out[s];
-        d.color = {deep.deep_value(px, cR, s), deep.deep_value(px, cG, s), deep.deep_value(px, cB, s),
-                   cA >= 0 ? deep.deep_value(px, cA, s) : 1.0f};
+        const float alpha = cc.a >= 0 ? deep.deep_value(px, cc.a, s) : 1.0f;
+        d.color = cc.complete() ? glm::vec4(deep.deep_value(px, cc.r, s), deep.deep_value(px, cc.g, s),
+                                            deep.deep_value(px, cc.b, s), alpha)
+                                : glm::vec4(0.0f, 0.0f, 0.0f, alpha);
         d.depth = cZ >= 0 ? deep.deep_value(px, cZ, s) : kInf;
         d.instance = deepId(path, deep, cInstance, kInstance, kNoId, px, s, x, y);
         d.triangle = deepId(path, deep, cTriangle, kTriangle, kNoId, px, s, x, y);
         // Without id.sample every layer counts as sample 0.
         d.sample = deepId(path, deep, cSample, kSample, 0, px, s, x, y);
+        // A flag, read like an ID (uint, or integral half/float); absent: false.
+        d.cutOff = deepId(path, deep, cCutoff, kCutoff, 0, px, s, x, y) != 0;
       }
       // Files from other renderers need not be in our order (DeepImage).
       std::stable_sort(out, out + n, deepSampleBefore);

@@ -11,9 +11,12 @@
 // - Deep EXR: every sample of every pixel and, with transparency, every
 //   layer, front to back; the same channels plus id.sample (uint, the
 //   sample's index in the SPEC §3 pattern) so a reader can tell samples
-//   and layers apart. Colour is float here (deep files are for
-//   sample-exact analysis). Deep data are stored as OpenEXR deep
-//   scanlines, zips compression.
+//   and layers apart, and cutoff (uint: 1 on the layer after which the
+//   renderer stopped looking, DeepSample::cutOff; 0 elsewhere). Colour is
+//   float here (deep files are for sample-exact analysis). Deep data are
+//   stored as OpenEXR deep scanlines, zips compression.
+// - Files from other renderers may carry any subset of these channels
+//   (SPEC §6), e.g. only Z and the IDs: see the readers below.
 // Every file is written to a temporary name beside its target and renamed
 // into place, so an interrupted run never leaves a half-written output.
 #pragma once
@@ -34,6 +37,10 @@ struct FlatImage {
   std::vector<float> depth;        // view depth; +inf: nothing hit
   std::vector<uint32_t> instance;  // kNoId: nothing hit
   std::vector<uint32_t> triangle;
+  // False when read from a file without all of R, G and B (a visibility
+  // export): `color` then holds no colour (RGB 0, A as the file has it)
+  // and colour metrics must be skipped. Writers ignore it.
+  bool hasColor = true;
 
   FlatImage() = default;
   FlatImage(int w, int h);  // transparent black, +inf depth, kNoId ids
@@ -53,10 +60,13 @@ struct DeepSample {
 
 // Deep frame: pixel i owns samples[offsets[i], offsets[i + 1]), sorted by
 // (sample, depth, instance, triangle): front to back within each sample.
+// Offsets are 64-bit: a large image at many spp with many layers exceeds
+// 2^32 entries, which a 32-bit offset would wrap silently.
 struct DeepImage {
   int width = 0, height = 0;
-  std::vector<uint32_t> offsets;  // width·height + 1 entries
+  std::vector<uint64_t> offsets;  // width·height + 1 entries
   std::vector<DeepSample> samples;
+  bool hasColor = true;  // as FlatImage::hasColor
 };
 
 enum class ColorPrecision { Half, Float };
@@ -74,11 +84,15 @@ void writeExr(const std::string& path, const FlatImage& image,
               ColorPrecision precision = ColorPrecision::Half);
 void writeDeepExr(const std::string& path, const DeepImage& image);
 
-// Readers for the compare tool; accept files from other renderers as long
-// as they carry the SPEC §6 channels (missing Z or IDs read as +inf and
-// kNoId; missing A reads as 1). Throw InputError naming the file and the
-// channel or element at fault (element "" when the file as a whole cannot
-// be read: missing, not OpenEXR, truncated or corrupt).
+// Readers for the compare tool; accept files from other renderers with any
+// subset of the SPEC §6 channels: missing Z or IDs read as +inf and kNoId,
+// missing A as 1, a missing cutoff as false; without all of R, G and B the
+// image has hasColor = false (a visibility export: Z and IDs only). A file
+// with none of R G B A Z id.instance id.triangle is refused: it is not a
+// rastray-style file at all, and comparing it would report "nothing hit"
+// everywhere. Throw InputError naming the file and the channel or element
+// at fault (element "" when the file as a whole cannot be read: missing,
+// not OpenEXR, truncated or corrupt).
 // - Only the first part (subimage) of a multi-part file is read.
 // - The image covers the display window; pixels outside a smaller data
 //   window read as transparent black, +inf depth, kNoId (no samples, deep).

@@ -23,6 +23,7 @@ std::vector<glm::dvec2> fromPattern(const int (&pattern)[N][2]) {
 }
 
 int gridSide(int spp) {
+  if (spp <= 0 || spp > kMaxGridSide * kMaxGridSide) return 0;
   int n = static_cast<int>(std::lround(std::sqrt(static_cast<double>(spp))));
   return (n > 4 && n * n == spp) ? n : 0;
 }
@@ -33,7 +34,10 @@ bool isSupportedSampleCount(int spp) {
   return spp == 1 || spp == 2 || spp == 4 || spp == 8 || spp == 16 || gridSide(spp) > 0;
 }
 
-std::string supportedSampleCounts() { return "1, 2, 4, 8, 16 or n*n for n > 4"; }
+std::string supportedSampleCounts() {
+  return "1, 2, 4, 8, 16 or n*n for 4 < n <= " + std::to_string(kMaxGridSide) + ", at most " +
+         std::to_string(kMaxGridSide * kMaxGridSide);
+}
 
 std::vector<glm::dvec2> samplePositions(int spp) {
   switch (spp) {

@@ -4,8 +4,9 @@
 // Positions are in pixel units from the pixel's top-left corner, y down.
 // 1 spp: the centre. 2, 4, 8, 16 spp: the standard Direct3D multisample
 // patterns (given there in 1/16 pixel from the centre, y down). n² spp for
-// n > 4: the centres of an n×n grid. Every position is an exact multiple of
-// 1/16 for the Direct3D patterns, and of 1/(2n) for the grids.
+// 4 < n <= kMaxGridSide: the centres of an n×n grid. Every position is an
+// exact multiple of 1/16 for the Direct3D patterns, and of 1/(2n) for the
+// grids.
 #pragma once
 
 #include <string>
@@ -15,7 +16,17 @@
 
 namespace rastray {
 
-// True for 1, 2, 4, 8, 16 and n² with n > 4.
+// The largest grid side: at most 16×16 = 256 spp. Why a bound at all:
+// every entry of the per-sample buffers and deep files grows with spp (a
+// 1920×1080 deep frame at 256 spp is already 530 M entries per layer),
+// and the rasterizer's fixed-point grid refines by k = 2n / gcd(2n, 256)
+// (raster/setup.h), which shrinks its largest image as 2^20 / k; up to
+// n = 16 k stays <= 15 (images up to 69,905 pixels across), beyond it
+// grows without limit. 256 samples are far past the point where more
+// samples change a visibility comparison.
+constexpr int kMaxGridSide = 16;
+
+// True for 1, 2, 4, 8, 16 and n² with 4 < n <= kMaxGridSide.
 bool isSupportedSampleCount(int spp);
 
 // The sample positions for spp samples per pixel. Throws std::invalid_argument
@@ -26,7 +37,7 @@ std::vector<glm::dvec2> samplePositions(int spp);
 // index); flat EXR files store this sample's Z and IDs (SPEC §6).
 int centreSampleIndex(int spp);
 
-// "1, 2, 4, 8, 16 or n² for n > 4", for messages.
+// "1, 2, 4, 8, 16 or n*n for 4 < n <= 16, at most 256", for messages.
 std::string supportedSampleCounts();
 
 }  // namespace rastray

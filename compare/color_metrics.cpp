@@ -56,10 +56,11 @@ ColorMetrics compareColors(const FlatImage& a, const FlatImage& b) {
 
 FlatImage flattenDeepColor(const DeepImage& deep, int spp) {
   FlatImage out(deep.width, deep.height);
+  out.hasColor = deep.hasColor;
   const float weight = 1.0f / float(std::max(spp, 1));
   for (size_t p = 0; p + 1 < deep.offsets.size(); ++p) {
     glm::vec4 sum(0.0f), sample(0.0f);
-    for (uint32_t i = deep.offsets[p]; i < deep.offsets[p + 1]; ++i) {
+    for (uint64_t i = deep.offsets[p]; i < deep.offsets[p + 1]; ++i) {
       const DeepSample& d = deep.samples[i];
       // Entries are sorted by (sample, depth): a new sample index closes the last one.
       if (i > deep.offsets[p] && d.sample != deep.samples[i - 1].sample) {

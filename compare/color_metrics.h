@@ -45,7 +45,7 @@ ColorMetrics compareColors(const FlatImage& a, const FlatImage& b);
 // Composites each sample's layers front to back (over, premultiplied) and
 // averages the spp samples of each pixel with equal weights; samples a file
 // does not list count as transparent black. Z and IDs of the result are
-// left empty (+inf, kNoId).
+// left empty (+inf, kNoId); hasColor is the deep image's.
 FlatImage flattenDeepColor(const DeepImage& deep, int spp);
 
 // Per-pixel largest |A − B| over RGBA, for the heat map.

@@ -52,10 +52,43 @@ uint64_t countHits(const FlatImage& f) {
   return n;
 }
 
+// Why the colour metrics cannot be computed (empty: they can): both files
+// need R, G and B (the readers' hasColor).
+std::string colorSkipReason(const FlatImage& a, const FlatImage& b, const std::string& pathA,
+                            const std::string& pathB) {
+  if (a.hasColor && b.hasColor) return "";
+  const std::string lacking = !a.hasColor && !b.hasColor ? pathA + " and " + pathB + " have"
+                              : a.hasColor               ? pathB + " has"
+                                                         : pathA + " has";
+  return lacking + " no R G B channels: visibility and depth only";
+}
+
 uint64_t countHits(const DeepImage& d) {
   uint64_t n = 0;
   for (const DeepSample& s : d.samples) n += HitRecord{s.instance, s.triangle}.isHit();
   return n;
+}
+
+// The colour metrics, or {"skipped": why} when a file has no colour.
+nlohmann::json colorJson(const CompareResult& r) {
+  if (!r.colorSkipped.empty()) return {{"skipped", r.colorSkipped}};
+  const ColorMetrics& c = r.color;
+  return {{"space", "linear premultiplied RGBA"},
+          {"method", "OpenImageIO ImageBufAlgo::compare"},
+          {"meanError", number(c.meanError)},
+          {"rmsError", number(c.rmsError)},
+          {"psnr", number(c.psnr)},
+          {"maxError", number(c.maxError)},
+          {"maxAt", c.maxX >= 0
+                        ? nlohmann::json{{"x", c.maxX}, {"y", c.maxY}, {"channel", channelName(c.maxChannel)}}
+                        : nlohmann::json(nullptr)},
+          {"pixels", c.pixels},
+          {"differingPixels", c.differingPixels},
+          {"perceptual",
+           {{"metric", "Yee perceptual difference (OpenImageIO ImageBufAlgo::compare_Yee)"},
+            {"failingPixels", c.yeeFailingPixels},
+            {"luminance", c.yeeLuminance},
+            {"fieldOfViewDegrees", c.yeeFieldOfView}}}};
 }
 
 }  // namespace
@@ -135,7 +168,8 @@ CompareResult compareFiles(const CompareInputs& in) {
     r.colorA = std::move(flatA);
     r.colorB = std::move(flatB);
   }
-  r.color = compareColors(r.colorA, r.colorB);
+  r.colorSkipped = colorSkipReason(r.colorA, r.colorB, in.pathA, in.pathB);
+  if (r.colorSkipped.empty()) r.color = compareColors(r.colorA, r.colorB);
 
   // A file without id channels reads as "nothing hit" everywhere (the
   // readers' convention); say so rather than let it pass as plain mismatches.
@@ -166,6 +200,10 @@ std::vector<std::string> thresholdViolations(const CompareResult& r, const Thres
                   static_cast<unsigned long long>(genuine), unit,
                   static_cast<unsigned long long>(*t.maxGenuine));
     out.push_back(buf);
+  }
+  if (t.failRms && !r.colorSkipped.empty()) {
+    out.push_back("--fail-rms cannot apply: colour skipped (" + r.colorSkipped + ")");
+    return out;
   }
   // NaN RMS (NaN colours) fails too: a comparison that cannot be made is not a pass.
   if (t.failRms && !(r.color.rmsError <= *t.failRms)) {
@@ -219,24 +257,7 @@ nlohmann::json toJson(const CompareResult& r, const Thresholds& t,
                                                   : nlohmann::json(nullptr)},
       {"meanRelative", v.depth.meanRelative},
       {"maxRelative", v.depth.maxRelative}};
-  const ColorMetrics& c = r.color;
-  j["color"] = {
-      {"space", "linear premultiplied RGBA"},
-      {"method", "OpenImageIO ImageBufAlgo::compare"},
-      {"meanError", number(c.meanError)},
-      {"rmsError", number(c.rmsError)},
-      {"psnr", number(c.psnr)},
-      {"maxError", number(c.maxError)},
-      {"maxAt", c.maxX >= 0
-                    ? nlohmann::json{{"x", c.maxX}, {"y", c.maxY}, {"channel", channelName(c.maxChannel)}}
-                    : nlohmann::json(nullptr)},
-      {"pixels", c.pixels},
-      {"differingPixels", c.differingPixels},
-      {"perceptual",
-       {{"metric", "Yee perceptual difference (OpenImageIO ImageBufAlgo::compare_Yee)"},
-        {"failingPixels", c.yeeFailingPixels},
-        {"luminance", c.yeeLuminance},
-        {"fieldOfViewDegrees", c.yeeFieldOfView}}}};
+  j["color"] = colorJson(r);
   nlohmann::json th = nlohmann::json::object();
   if (t.minAgreement) th["minAgreement"] = *t.minAgreement;
   if (t.maxGenuine) th["maxGenuine"] = *t.maxGenuine;
@@ -305,16 +326,20 @@ std::string formatTable(const CompareResult& r, const Thresholds& t,
   }
 
   const ColorMetrics& c = r.color;
-  s += "\ncolour (OpenImageIO ImageBufAlgo::compare on linear premultiplied RGBA";
-  s += v.deep ? "; deep layers composited, samples box-averaged)\n" : ")\n";
-  line("  mean %.6g  RMS %.6g  PSNR %.4g dB  max %.6g", c.meanError, c.rmsError, c.psnr, c.maxError);
-  if (c.maxX >= 0) line(" at pixel (%d, %d) channel %s", c.maxX, c.maxY, channelName(c.maxChannel));
-  line("\n  %llu of %llu pixels differ\n", static_cast<unsigned long long>(c.differingPixels),
-       static_cast<unsigned long long>(c.pixels));
-  line(
-      "  perceptual: Yee (ImageBufAlgo::compare_Yee, %.0f cd/m2, %.0f deg): %llu pixels perceptibly "
-      "different\n",
-      c.yeeLuminance, c.yeeFieldOfView, static_cast<unsigned long long>(c.yeeFailingPixels));
+  if (!r.colorSkipped.empty()) {
+    s += "\ncolour: skipped (" + r.colorSkipped + ")\n";
+  } else {
+    s += "\ncolour (OpenImageIO ImageBufAlgo::compare on linear premultiplied RGBA";
+    s += v.deep ? "; deep layers composited, samples box-averaged)\n" : ")\n";
+    line("  mean %.6g  RMS %.6g  PSNR %.4g dB  max %.6g", c.meanError, c.rmsError, c.psnr, c.maxError);
+    if (c.maxX >= 0) line(" at pixel (%d, %d) channel %s", c.maxX, c.maxY, channelName(c.maxChannel));
+    line("\n  %llu of %llu pixels differ\n", static_cast<unsigned long long>(c.differingPixels),
+         static_cast<unsigned long long>(c.pixels));
+    line(
+        "  perceptual: Yee (ImageBufAlgo::compare_Yee, %.0f cd/m2, %.0f deg): %llu pixels perceptibly "
+        "different\n",
+        c.yeeLuminance, c.yeeFieldOfView, static_cast<unsigned long long>(c.yeeFailingPixels));
+  }
 
   for (const std::string& note : r.notes) s += "\nnote: " + note + "\n";
   if (t.minAgreement || t.maxGenuine || t.failRms) {

@@ -1,7 +1,9 @@
 // `rastray compare` as a library call: two SPEC §6 EXR files (flat or
 // deep, from any renderer) in, visibility agreement with classified
 // mismatches, depth and colour metrics out; plus thresholds, a readable
-// table and a JSON report.
+// table and a JSON report. Either file may hold any subset of the SPEC §6
+// channels: without R, G and B in both (e.g. another renderer's Z + ID
+// export) the colour metrics are skipped and the reports say why.
 #pragma once
 
 #include <cstdint>
@@ -31,7 +33,8 @@ struct CompareResult {
   std::string camera;  // Camera::describe() with a scene; empty otherwise
   bool sppInferred = false;
   VisibilityReport visibility;
-  ColorMetrics color;
+  ColorMetrics color;              // all zero when colorSkipped is set
+  std::string colorSkipped;        // why the colour metrics were skipped; empty: they were computed
   FlatImage colorA, colorB;        // the colours compared (deep files flattened)
   std::vector<std::string> notes;  // caveats for the reader, e.g. a file without IDs
 };
@@ -46,7 +49,9 @@ struct Thresholds {
   std::optional<double> failRms;       // colour RMS error above this fails
 };
 
-// One line per violated threshold (empty: all passed).
+// One line per violated threshold (empty: all passed). --fail-rms with the
+// colour metrics skipped is a violation: a check that could not be made is
+// not a pass.
 std::vector<std::string> thresholdViolations(const CompareResult& result, const Thresholds& thresholds);
 
 nlohmann::json toJson(const CompareResult& result, const Thresholds& thresholds,

@@ -1,6 +1,8 @@
 #include "common/sampling.h"
 
+#include <limits>
 #include <set>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -11,6 +13,18 @@ TEST(Sampling, SupportedCounts) {
   for (int spp : {1, 2, 4, 8, 16, 25, 36, 64, 100}) EXPECT_TRUE(isSupportedSampleCount(spp)) << spp;
   for (int spp : {0, -1, 3, 5, 9, 12, 24, 26}) EXPECT_FALSE(isSupportedSampleCount(spp)) << spp;
   EXPECT_THROW(samplePositions(9), std::invalid_argument);
+}
+
+TEST(Sampling, GridsStopAt16By16) {
+  EXPECT_TRUE(isSupportedSampleCount(kMaxGridSide * kMaxGridSide));
+  EXPECT_EQ(kMaxGridSide, 16);
+  EXPECT_EQ(samplePositions(256).size(), 256u);
+  for (int spp : {289, 324, 400, 1024, 65536, 46340 * 46340, std::numeric_limits<int>::max()})
+    EXPECT_FALSE(isSupportedSampleCount(spp)) << spp;
+  EXPECT_THROW(samplePositions(289), std::invalid_argument);
+  // The message names the bound, so a user asking for 289 sees why.
+  EXPECT_NE(supportedSampleCounts().find("n <= 16"), std::string::npos) << supportedSampleCounts();
+  EXPECT_NE(supportedSampleCounts().find("256"), std::string::npos) << supportedSampleCounts();
 }
 
 TEST(Sampling, OneSampleIsThePixelCentre) {

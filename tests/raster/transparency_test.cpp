@@ -68,7 +68,7 @@ TEST(Transparency, SortedIsWrongOnCyclicOverlapWhileExactIsRight) {
   o.peelLayers = 3;
   const RenderOutput peel = test::render(scene, camera, o);
   const auto misordered = [](const DeepImage& d, size_t p) {
-    for (uint32_t k = d.offsets[p] + 1; k < d.offsets[p + 1]; ++k)
+    for (uint64_t k = d.offsets[p] + 1; k < d.offsets[p + 1]; ++k)
       if (d.samples[k].sample == d.samples[k - 1].sample && d.samples[k].depth < d.samples[k - 1].depth)
         return true;
     return false;
