@@ -1,5 +1,7 @@
 #include "common/surface.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace rastray {
@@ -53,7 +55,21 @@ SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit) {
 bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle, const Ray& ray,
                             double* t, glm::dvec2* barycentrics) {
   const glm::uvec3 v = scene.triangle(instance, triangle);
-  const glm::dvec3 a(scene.positions[v.x]), b(scene.positions[v.y]), c(scene.positions[v.z]);
+  // The corners in a canonical (lexicographic) order, so that coincident
+  // triangles listed with their vertices in another order (duplicated or
+  // reversed faces) get bit-identical t: their layers then tie exactly and
+  // are ordered by (instance, triangle) in both renderers.
+  std::array<glm::dvec3, 3> corner = {glm::dvec3(scene.positions[v.x]), glm::dvec3(scene.positions[v.y]),
+                                      glm::dvec3(scene.positions[v.z])};
+  std::array<int, 3> order = {0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](int i, int j) {
+    const glm::dvec3 &p = corner[size_t(i)], &q = corner[size_t(j)];
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    return p.z < q.z;
+  });
+  const glm::dvec3 &a = corner[size_t(order[0])], &b = corner[size_t(order[1])],
+                   &c = corner[size_t(order[2])];
   // Möller–Trumbore in double, without the inside test.
   const glm::dvec3 e1 = b - a, e2 = c - a;
   const glm::dvec3 p = glm::cross(ray.direction, e2);
@@ -61,12 +77,17 @@ bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t tria
   if (!(std::abs(det) > 0.0)) return false;
   const double inv = 1.0 / det;
   const glm::dvec3 s = ray.origin - a;
-  const double b1 = glm::dot(s, p) * inv;
+  const double u = glm::dot(s, p) * inv;
   const glm::dvec3 q = glm::cross(s, e1);
-  const double b2 = glm::dot(ray.direction, q) * inv;
+  const double w = glm::dot(ray.direction, q) * inv;
   *t = glm::dot(e2, q) * inv;
-  *barycentrics = glm::dvec2(b1, b2);
-  return std::isfinite(*t) && std::isfinite(b1) && std::isfinite(b2);
+  // Back to the stored order: weight[k] belongs to stored corner k.
+  std::array<double, 3> weight{};
+  weight[size_t(order[0])] = 1.0 - u - w;
+  weight[size_t(order[1])] = u;
+  weight[size_t(order[2])] = w;
+  *barycentrics = glm::dvec2(weight[1], weight[2]);
+  return std::isfinite(*t) && std::isfinite(u) && std::isfinite(w);
 }
 
 SampleHit refineHit(const Scene& scene, const Ray& ray, const SampleHit& hit) {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "common/depth_formula.h"
+#include "common/surface.h"
 
 namespace rastray {
 
@@ -130,6 +131,20 @@ bool MismatchClassifier::isDepthTie(const HitRecord& a, const HitRecord& b) cons
   return std::fabs(dA - dB) <= tol;  // tol = inf only when d <= 0, a hit behind the eye: no tie then
 }
 
+bool MismatchClassifier::isGeometricDepthTie(glm::dvec2 sample, const HitRecord& a,
+                                             const HitRecord& b) const {
+  if (!geometric() || !a.isHit() || !b.isHit()) return false;
+  const Ray ray = settings_.camera->primaryRay(sample);
+  double tA, tB;
+  glm::dvec2 bary;
+  if (!intersectTrianglePlane(*settings_.scene, a.instance, a.triangle, ray, &tA, &bary) ||
+      !intersectTrianglePlane(*settings_.scene, b.instance, b.triangle, ray, &tB, &bary))
+    return false;
+  const double dA = tA * ray.depthPerT, dB = tB * ray.depthPerT;
+  if (!(dA > 0.0) || !(dB > 0.0) || !std::isfinite(dA) || !std::isfinite(dB)) return false;
+  return std::fabs(dA - dB) <= depthTieTolerance(settings_.depthFormat, settings_.planes, dA, dB);
+}
+
 bool MismatchClassifier::touchesNearOrFarPlane(const HitRecord& h) const {
   const DepthPlanes& p = settings_.planes;
   if (!p.known || !h.isHit() || std::isnan(h.depth)) return false;
@@ -159,7 +174,12 @@ double MismatchClassifier::distanceToSegment(glm::dvec2 sample, const glm::dvec3
   };
   if (!clipAgainst(dp - cam.znear, dq - cam.znear)) return kInf;
   if (std::isfinite(cam.zfar) && !clipAgainst(cam.zfar - dp, cam.zfar - dq)) return kInf;
-  const glm::dvec3 a = p + t0 * (q - p), b = p + t1 * (q - p);
+  return distanceToViewSegment(sample, p + t0 * (q - p), p + t1 * (q - p));
+}
+
+double MismatchClassifier::distanceToViewSegment(glm::dvec2 sample, const glm::dvec3& a,
+                                                 const glm::dvec3& b) const {
+  const Camera& cam = *settings_.camera;
   const glm::dvec2 scale = cam.ndcScale();
   auto project = [&](const glm::dvec3& v) {
     const double w = cam.projection == Projection::Orthographic ? 1.0 : -v.z;
@@ -181,6 +201,22 @@ double MismatchClassifier::distanceToTriangleEdges(glm::dvec2 sample, const HitR
   for (int e = 0; e < 3; ++e) {
     const glm::dvec3 p(scene.positions[tri[e]]), q(scene.positions[tri[(e + 1) % 3]]);
     best = std::min(best, distanceToSegment(sample, p, q));
+  }
+  // Where the triangle crosses the near or the far plane its visible part
+  // has an edge too: the segment the plane cuts out of it.
+  const Camera& cam = *settings_.camera;
+  glm::dvec3 v[3];
+  for (int k = 0; k < 3; ++k)
+    v[k] = glm::dvec3(cam.viewFromWorld * glm::dvec4(glm::dvec3(scene.positions[tri[k]]), 1.0));
+  for (const double plane : {cam.znear, cam.zfar}) {
+    if (!std::isfinite(plane)) continue;
+    std::vector<glm::dvec3> cut;
+    for (int e = 0; e < 3; ++e) {
+      const glm::dvec3 &p = v[e], &q = v[(e + 1) % 3];
+      const double fp = -p.z - plane, fq = -q.z - plane;
+      if ((fp < 0.0) != (fq < 0.0)) cut.push_back(p + (fp / (fp - fq)) * (q - p));
+    }
+    if (cut.size() == 2) best = std::min(best, distanceToViewSegment(sample, cut[0], cut[1]));
   }
   return best;
 }
@@ -213,7 +249,7 @@ MismatchClass MismatchClassifier::classify(glm::dvec2 sample, const HitRecord& a
              evidence.edgeNearby) {
     return MismatchClass::SharedEdgeTie;
   }
-  if (isDepthTie(a, b)) return MismatchClass::DepthTie;
+  if (isDepthTie(a, b) || isGeometricDepthTie(sample, a, b)) return MismatchClass::DepthTie;
   if (touchesNearOrFarPlane(a) || touchesNearOrFarPlane(b)) return MismatchClass::NearFarPlane;
   if (geometric()) {
     if (distanceToTriangleEdges(sample, a) <= limit || distanceToTriangleEdges(sample, b) <= limit)

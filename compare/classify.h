@@ -8,13 +8,16 @@
 //      sample lies within `edgeDistance` pixels of that edge in the image.
 //      SPEC §3 lets the renderers pick either triangle there.
 //   2. depth tie: both hit, and |ΔZ| <= depthTieTolerance (below): the two
-//      surfaces are closer than the depth format can tell apart (z-fighting).
+//      surfaces are closer than the depth format can tell apart (z-fighting),
+//      by the reported depths or, with a scene, by the exact depths of the
+//      two triangles' planes along the sample's camera ray.
 //   3. near/far plane: a hit lies within planeTolerance of znear or zfar, or
 //      beyond either plane (the other renderer clipped it, or should have).
 //   4. silhouette edge: the sample lies within `edgeDistance` pixels of an
-//      edge of either hit triangle (its image-space projection, clipped to
-//      the near and far planes), where vertex snapping and float
-//      intersection legitimately move coverage.
+//      edge of the visible part of either hit triangle (its edges' image-
+//      space projections clipped to the near and far planes, and the
+//      segments those planes cut out of it), where vertex snapping and
+//      float intersection legitimately move coverage.
 //   5. genuine: none of the above: a real disagreement.
 // Numeric classes (2, 3) come before the edge test because they are exact;
 // the shared-edge test comes first because it is the most specific.
@@ -150,10 +153,17 @@ class MismatchClassifier {
   double distanceToSharedEdge(glm::dvec2 sample, const HitRecord& a, const HitRecord& b);
 
   bool isDepthTie(const HitRecord& a, const HitRecord& b) const;
+  // The same test on the exact depths of the two triangles' planes along
+  // the sample's camera ray (double): coincident or coplanar surfaces tie
+  // there even when a renderer's own Z rounding (Embree's float t) puts the
+  // reported depths a few ULPs further apart than the format resolves.
+  bool isGeometricDepthTie(glm::dvec2 sample, const HitRecord& a, const HitRecord& b) const;
   bool touchesNearOrFarPlane(const HitRecord& h) const;
 
  private:
   double distanceToSegment(glm::dvec2 sample, const glm::dvec3& p, const glm::dvec3& q) const;
+  // Image-space distance to a segment given in view space, in front of the eye.
+  double distanceToViewSegment(glm::dvec2 sample, const glm::dvec3& a, const glm::dvec3& b) const;
 
   ClassifierSettings settings_;
 };

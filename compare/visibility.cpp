@@ -209,13 +209,16 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
         const HitRecord* lb = fb.begin(slot);
         const glm::dvec2 position = glm::dvec2(x, y) + slotPositions[size_t(s)];
         // Records one compared pair (a layer, or the sample's front layers).
+        // Records one compared pair; returns its class (none: agreement).
+        // `inherited`: the class to give a mismatch instead of classifying it.
         auto record = [&](const HitRecord& a, const HitRecord& b, size_t layer, AgreementCounts& c,
-                          bool isLayer) {
+                          bool isLayer,
+                          std::optional<MismatchClass> inherited = {}) -> std::optional<MismatchClass> {
           ++c.compared;
           if (a.sameSurface(b)) {
             ++c.agreeing;
             c.bothEmpty += !a.isHit();
-            if (!isLayer) return;
+            if (!isLayer) return std::nullopt;
             vis = std::max(vis, a.isHit() ? PixelVisibility::Agree : PixelVisibility::BothEmpty);
             if (a.isHit() && std::isfinite(a.depth) && std::isfinite(b.depth)) {
               const double absolute = std::fabs(double(a.depth) - double(b.depth));
@@ -233,16 +236,22 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
               float& pe = r.pixelDepthError[pixel];
               if (std::isnan(pe) || float(absolute) > pe) pe = float(absolute);
             }
-            return;
+            return std::nullopt;
           }
-          const ImageSpaceEvidence evidence =
-              classifier.geometric() ? ImageSpaceEvidence{} : imageSpaceEvidence(fa, fb, x, y, a, b);
-          const MismatchClass cls = classifier.classify(position, a, b, evidence);
+          MismatchClass cls;
+          if (inherited) {
+            cls = *inherited;
+          } else {
+            const ImageSpaceEvidence evidence =
+                classifier.geometric() ? ImageSpaceEvidence{} : imageSpaceEvidence(fa, fb, x, y, a, b);
+            cls = classifier.classify(position, a, b, evidence);
+          }
           ++c.mismatches[size_t(cls)];
-          if (!isLayer) return;
+          if (!isLayer) return cls;
           vis = std::max(vis, toPixelVisibility(cls));
           auto& example = r.examples[size_t(cls)];
           if (!example) example = MismatchExample{x, y, slotSamples[size_t(s)], int(layer), a, b};
+          return cls;
         };
         const size_t na = fa.layerCount(slot), nb = fb.layerCount(slot);
         // The sample: its front surfaces.
@@ -264,6 +273,17 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
           if (cutA && aligned[k].first + 1 == cutA) behindA = k + 1;
           if (cutB && aligned[k].second + 1 == cutB) behindB = k + 1;
         }
+        // A list that ends early (its last layer opaque, where the other
+        // renderer saw something else): the other's layers behind that
+        // point were hidden by it, so they share the class of the mismatch
+        // at its last layer (a silhouette one renderer caught and the other
+        // missed hides or reveals everything behind it).
+        size_t endA = aligned.size(), endB = aligned.size();
+        for (size_t k = 0; k < aligned.size(); ++k) {
+          if (na && aligned[k].first + 1 == na) endA = k;
+          if (nb && aligned[k].second + 1 == nb) endB = k;
+        }
+        std::optional<MismatchClass> classAtEndA, classAtEndB;
         bool sampleCutOff = false;
         for (size_t k = 0; k < aligned.size(); ++k) {
           const auto [ia, ib] = aligned[k];
@@ -285,14 +305,19 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
             }
             continue;
           }
-          record(ia < na ? la[ia] : empty, ib < nb ? lb[ib] : empty, std::min(ia, ib), r.layers, true);
+          std::optional<MismatchClass> inherited;
+          if (ia >= na && k > endA && classAtEndA != MismatchClass::Genuine) inherited = classAtEndA;
+          if (ib >= nb && k > endB && classAtEndB != MismatchClass::Genuine) inherited = classAtEndB;
+          const auto cls = record(ia < na ? la[ia] : empty, ib < nb ? lb[ib] : empty, std::min(ia, ib),
+                                  r.layers, true, inherited);
+          if (k == endA) classAtEndA = cls;
+          if (k == endB) classAtEndB = cls;
         }
         r.cutOff.samples += sampleCutOff;
       }
       cutOffColor /= double(fa.slots);
-      const double share =
-          std::max(std::max(std::fabs(cutOffColor.r), std::fabs(cutOffColor.g)),
-                   std::max(std::fabs(cutOffColor.b), std::fabs(cutOffColor.a)));
+      const double share = std::max(std::max(std::fabs(cutOffColor.r), std::fabs(cutOffColor.g)),
+                                    std::max(std::fabs(cutOffColor.b), std::fabs(cutOffColor.a)));
       sumCutOffColor += share;
       if (share > r.cutOff.maxColor) {
         r.cutOff.maxColor = share;

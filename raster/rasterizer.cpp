@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -65,6 +66,22 @@ class Renderer {
   SampleHit hitAt(const TriangleSetup& t, const glm::dvec2& pos) const {
     const glm::dvec2 b = t.baryAt(pos.x, pos.y);
     return {t.instance, t.triangle, float(t.viewDepthAt(pos.x, pos.y)), float(b.x), float(b.y)};
+  }
+
+  // The depth that orders BLEND layers: the view depth of the stored
+  // triangle's plane along the primary ray (intersectTrianglePlane, double),
+  // the key the ray caster sorts its layers by, so both renderers order
+  // layers alike, and coincident duplicates tie exactly and fall back to
+  // (instance, triangle). The interpolated depth when the plane is missed.
+  double layerDepth(const TriangleSetup& t, const glm::dvec2& pos) const {
+    const Ray ray = camera_.primaryRay(pos);
+    double th;
+    glm::dvec2 b;
+    if (intersectTrianglePlane(scene_, t.instance, t.triangle, ray, &th, &b) && th > 0.0) {
+      const double d = th * ray.depthPerT;
+      if (std::isfinite(d)) return d;
+    }
+    return t.viewDepthAt(pos.x, pos.y);
   }
 
   // The same inputs the ray caster shades from: the hit refined on the
@@ -273,7 +290,7 @@ void Renderer::transparencyPass(const TileRect& rect, const std::vector<uint32_t
                              win == kNoSetup ? UINT64_MAX : setups_[win].id()))
           return;
         const glm::dvec2 pos = glm::dvec2(px, py) + grid_.positions[size_t(s)];
-        f(Fragment{localIndex(px, py, s), t.viewDepthAt(pos.x, pos.y), id, index, 0}, pos);
+        f(Fragment{localIndex(px, py, s), layerDepth(t, pos), id, index, 0}, pos);
       });
     }
   };
