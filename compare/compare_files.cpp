@@ -239,7 +239,14 @@ nlohmann::json toJson(const CompareResult& r, const Thresholds& t,
                                 : nlohmann::json(nullptr)}};
   nlohmann::json vis;
   vis[v.deep ? "samples" : "pixels"] = countsJson(v.samples);
-  if (v.deep) vis["layers"] = countsJson(v.layers);
+  if (v.deep) {
+    vis["layers"] = countsJson(v.layers);
+    vis["cutOff"] = {{"layers", v.layers.cutOff},
+                     {"samples", v.cutOff.samples},
+                     {"meanColor", v.cutOff.meanColor},
+                     {"maxColor", v.cutOff.maxColor},
+                     {"maxAt", {v.cutOff.maxX, v.cutOff.maxY}}};
+  }
   nlohmann::json examples = nlohmann::json::object();
   for (int i = 0; i < kMismatchClassCount; ++i) {
     const auto& e = v.examples[size_t(i)];
@@ -316,6 +323,12 @@ std::string formatTable(const CompareResult& r, const Thresholds& t,
     line("    %-30s %10llu   %.6f   %s\n", displayName(cls),
          static_cast<unsigned long long>(v.layers.count(cls)), v.layers.fraction(cls), example.c_str());
   }
+  if (v.deep)
+    line(
+        "  cut off (not compared)  %10llu layers in %llu samples; their colour: mean %.3g, max %.3g per "
+        "pixel\n",
+        static_cast<unsigned long long>(v.layers.cutOff), static_cast<unsigned long long>(v.cutOff.samples),
+        v.cutOff.meanColor, v.cutOff.maxColor);
 
   const DepthErrorStats& d = v.depth;
   line("\ndepth error on %llu agreeing hits (view depth)\n", static_cast<unsigned long long>(d.count));

@@ -10,7 +10,8 @@
 //   16×16-pixel tiles in parallel (TBB). Each hit is refined with
 //   refineHit() before shading, exactly as the rasterizer does, so both
 //   shade a shared (instance, triangle) from identical inputs. Z is the
-//   refined hit's view depth (t · depthPerT in double); IDs are Embree's
+//   ray caster's own precision: Embree's float t × depthPerT of the
+//   front-most surface (the compare tool measures it); IDs are Embree's
 //   (geomID, primID) = SPEC §1 (instance, triangle).
 // - Transparency continuation: filter callbacks collect every BLEND hit
 //   along the ray and reject it, so one traversal continues from the same t
@@ -22,12 +23,18 @@
 //   RayOptions::transparencyCutoff (1e-4). MASK hits with alpha < cutoff
 //   are rejected and ignored. "rays.transparency" counts BLEND layers a ray
 //   continued behind.
-// - Duplicate hits: the same (instance, triangle) twice, or two triangles
-//   of one instance that share a vertex position hit at t equal within 32
-//   float ULPs of (t + |origin| + |vertices|) are one crossing (a ray
-//   through a shared edge or vertex); the first in (t, instance, triangle)
-//   order is kept. Applies to shadow rays as well, so a shared edge never
-//   attenuates twice.
+// - One crossing per surface (SPEC §1, §3): every triangle is its own
+//   layer, coincident duplicates included. Two reported hits are merged
+//   only when they are the same (instance, triangle), or when their
+//   triangles share a vertex position and lie on opposite sides of an edge
+//   through it seen along the ray (the ray went through their shared edge
+//   or vertex); the kept one is decided by an exact side test, as the
+//   rasterizer's top-left rule decides (CrossingRule in ray_caster.cpp).
+//   Shadow rays follow the same rule, so a shared edge attenuates once.
+// - Culling (constructor): single-sided triangles seen from the culled side
+//   are rejected by a filter on those geometries, for every ray kind.
+// - Cut-off (SPEC §6): when compositing stops with layers left, the last
+//   deep sample of that sample gets DeepSample::cutOff.
 // - Shadow rays (rtcOccluded1) run to the light (distance, or +inf for
 //   directional lights); occlusion filters accept opaque hits (blocked)
 //   and collect the rest, whose Shader::shadowTransmittance values multiply
