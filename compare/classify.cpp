@@ -136,10 +136,14 @@ bool MismatchClassifier::isGeometricDepthTie(glm::dvec2 sample, const HitRecord&
   if (!geometric() || !a.isHit() || !b.isHit()) return false;
   const Ray ray = settings_.camera->primaryRay(sample);
   double tA, tB;
-  glm::dvec2 bary;
-  if (!intersectTrianglePlane(*settings_.scene, a.instance, a.triangle, ray, &tA, &bary) ||
-      !intersectTrianglePlane(*settings_.scene, b.instance, b.triangle, ray, &tB, &bary))
+  glm::dvec2 baryA, baryB;
+  if (!intersectTrianglePlane(*settings_.scene, a.instance, a.triangle, ray, &tA, &baryA) ||
+      !intersectTrianglePlane(*settings_.scene, b.instance, b.triangle, ray, &tB, &baryB))
     return false;
+  // Both surfaces must be there: the ray passes inside both triangles (up
+  // to rounding; samples at their edges are the edge classes' business).
+  const auto inside = [](const glm::dvec2& w) { return std::min({w.x, w.y, 1.0 - w.x - w.y}) >= -1e-9; };
+  if (!inside(baryA) || !inside(baryB)) return false;
   const double dA = tA * ray.depthPerT, dB = tB * ray.depthPerT;
   if (!(dA > 0.0) || !(dB > 0.0) || !std::isfinite(dA) || !std::isfinite(dB)) return false;
   return std::fabs(dA - dB) <= depthTieTolerance(settings_.depthFormat, settings_.planes, dA, dB);

@@ -154,7 +154,8 @@ class MismatchClassifier {
 
   bool isDepthTie(const HitRecord& a, const HitRecord& b) const;
   // The same test on the exact depths of the two triangles' planes along
-  // the sample's camera ray (double): coincident or coplanar surfaces tie
+  // the sample's camera ray (double), when that ray passes inside both
+  // triangles: coincident or overlapping coplanar surfaces tie
   // there even when a renderer's own Z rounding (Embree's float t) puts the
   // reported depths a few ULPs further apart than the format resolves.
   bool isGeometricDepthTie(glm::dvec2 sample, const HitRecord& a, const HitRecord& b) const;
