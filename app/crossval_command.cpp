@@ -77,7 +77,7 @@ int runCrossval(CrossvalOptions& opt) {
   // Scenes are loaded one at a time: a bad file stops the run (exit 2)
   // before any report is written.
   for (size_t i = 0; i < opt.scenes.size(); ++i) {
-    const Scene scene = loadScene(opt.scenes[i]);
+    const Scene scene = loadSceneForRender(opt.scenes[i], opt.settings);
     auto progress = [&](const std::string& stage) {
       if (terminal)
         std::fprintf(stderr, "\r[%zu/%zu] %s: %-10s", i + 1, opt.scenes.size(), opt.scenes[i].c_str(),
@@ -111,7 +111,7 @@ int runCrossval(CrossvalOptions& opt) {
       const CrossvalResult& r = results[i];
       const std::string folder = opt.reportDir + "/" + std::filesystem::path(r.scenePath).stem().string();
       std::filesystem::create_directories(folder);
-      const Scene scene = loadScene(r.scenePath);
+      const Scene scene = loadSceneForRender(r.scenePath, opt.settings);
       for (int c = 0; c < kMismatchClassCount; ++c) {
         const auto& example = r.rasterVsRay.examples[size_t(c)];
         if (!example) continue;

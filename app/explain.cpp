@@ -156,7 +156,7 @@ struct ExplainOptions {
 
 int runExplain(ExplainOptions& opt) {
   opt.settings.finish();
-  const Scene scene = loadScene(opt.scenePath);
+  const Scene scene = loadSceneForRender(opt.scenePath, opt.settings);
   if (opt.x < 0 || opt.y < 0 || opt.x >= opt.settings.camera.width() || opt.y >= opt.settings.camera.height())
     throw InputError(
         "command line", "X Y",

@@ -48,7 +48,7 @@ int runRender(RenderCommandOptions& opt) {
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                     size_t(opt.settings.threads));
 
-  const Scene scene = loadScene(opt.scenePath);
+  const Scene scene = loadSceneForRender(opt.scenePath, opt.settings);
   RenderSettings settings = opt.settings;
   settings.keepSamples = opt.deep;
   const RenderRun run = renderScene(scene, settings);

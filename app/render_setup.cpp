@@ -103,6 +103,9 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
     {"--texture-filter", kAllRenderers, OptionCondition::Always,
      "sampler (as the file says), nearest, bilinear or trilinear",
      RASTRAY_BIND(cmd.add_option(name, s.textureFilter, help)->capture_default_str())},
+    {"--origin", kAllRenderers, OptionCondition::Always,
+     "camera (rebase the scene on the eye before rounding to float) or world (no rebasing)",
+     RASTRAY_BIND(cmd.add_option(name, s.origin, help)->capture_default_str())},
     {"--cull", kAllRenderers, OptionCondition::Always, "Cull single-sided triangles: back, front or none",
      RASTRAY_BIND(cmd.add_option(name, s.cull, help)->capture_default_str())},
     {"--shadows", kAllRenderers, OptionCondition::Always,
@@ -141,6 +144,10 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
      RASTRAY_BIND(cmd.add_option(name, s.ray.transparencyCutoff, help)
                       ->check(CLI::Range(0.0, 1.0))
                       ->capture_default_str())},
+    {"--ray-offset", kTraced, OptionCondition::Always,
+     "error-bound (from the hit's triangle, pbrt-v4) or float-ulps (from the hit point, Ray Tracing Gems "
+     "ch. 6): where secondary and shadow rays start",
+     RASTRAY_BIND(cmd.add_option(name, s.rayOffset, help)->capture_default_str())},
     // Traced primary rays.
     {"--no-packets", kRaytrace, OptionCondition::Always,
      "Trace primary rays one by one instead of in coherent packets",
@@ -231,6 +238,11 @@ void RenderSettings::finish() {
                                                {"nearest", TextureFilter::Nearest},
                                                {"bilinear", TextureFilter::Bilinear},
                                                {"trilinear", TextureFilter::Trilinear}});
+  renderOrigin =
+      pick<RenderOrigin>("--origin", origin, {{"camera", RenderOrigin::Camera}, {"world", RenderOrigin::World}});
+  ray.offset = pick<RayOffsetMethod>("--ray-offset", rayOffset,
+                                     {{"error-bound", RayOffsetMethod::ErrorBound},
+                                      {"float-ulps", RayOffsetMethod::FloatUlps}});
   if (!debugPixelXY.empty()) debugPixel = glm::ivec2(debugPixelXY[0], debugPixelXY[1]);
 
   raster.spp = spp;
@@ -319,6 +331,12 @@ void RenderSettings::finish() {
       badOption(spec.name, where + ", not to --renderer " + toString(renderer) + context);
     }
   }
+}
+
+Scene loadSceneForRender(const std::string& path, const RenderSettings& settings) {
+  Scene scene = loadScene(path);
+  applyRenderOrigin(scene, settings.renderOrigin, settings.camera.overrides());
+  return scene;
 }
 
 RenderRun renderScene(const Scene& scene, const RenderSettings& s) {

@@ -73,6 +73,8 @@ struct RenderSettings {
   std::string shadows;  // empty: map for raster, rays for hybrid
   std::string cull = "none", depthFormat = "float-reversed", depthFunc = "less", shadingRate = "sample";
   std::string textureFilter = "sampler";
+  std::string origin = "camera", rayOffset = "error-bound";
+  RenderOrigin renderOrigin = RenderOrigin::Camera;
   std::vector<float> polygonOffset, shadowBias;
   std::vector<int> debugPixelXY;
 
@@ -106,6 +108,10 @@ struct RenderRun {
   RenderOutput output;
   double seconds = 0.0;
 };
+
+// Loads a scene and rebases it on the render origin --origin names
+// (applyRenderOrigin); settings.finish() must have been called.
+Scene loadSceneForRender(const std::string& path, const RenderSettings& settings);
 
 // Runs the chosen renderer; settings.finish() must have been called.
 RenderRun renderScene(const Scene& scene, const RenderSettings& settings);

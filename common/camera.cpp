@@ -29,6 +29,8 @@ bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.
 
 }  // namespace
 
+const char* toString(RenderOrigin origin) { return origin == RenderOrigin::Camera ? "camera" : "world"; }
+
 CameraModel defaultCameraModel(const Scene& scene) {
   // Bounding sphere: the centre and half diagonal of the world bounds.
   glm::dvec3 centre(0.0);
@@ -87,7 +89,17 @@ std::string Camera::describe() const {
   else
     std::snprintf(buf, sizeof buf, "orthographic xmag %.6g ymag %.6g znear %.6g zfar %.6g", xmag, ymag, znear,
                   zfar);
-  return std::string(buf) + " eye " + fmt(eye()) + " forward " + fmt(forward()) + " [" + origin + "]";
+  return std::string(buf) + " eye " + fmt(eye() + worldOrigin) + " forward " + fmt(forward()) + " [" + origin + "]";
+}
+
+void applyRenderOrigin(Scene& scene, RenderOrigin mode, const CameraOverrides& overrides) {
+  if (mode == RenderOrigin::World) {
+    if (scene.origin != glm::dvec3(0.0)) rebaseScene(scene, glm::dvec3(0.0));
+    return;
+  }
+  // The eye does not depend on the image size; 1×1 binds any camera.
+  const Camera camera = makeCamera(scene, overrides, 1, 1);
+  rebaseScene(scene, scene.origin + camera.eye());
 }
 
 Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int width, int height) {
@@ -107,6 +119,7 @@ Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int widt
   camera.znear = model.znear;
   camera.zfar = model.zfar;
   camera.origin = model.origin;
+  camera.worldOrigin = scene.origin;
 
   // Orientation: the model's, unless eye/target/up say otherwise. The
   // model matrix may carry scale; only its rotation and position are used.
@@ -117,12 +130,12 @@ Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int widt
   bool reorient = false;
   if (overrides.eye) {
     if (!finite(*overrides.eye)) badOption("--eye", "must be finite");
-    eye = *overrides.eye;
+    eye = *overrides.eye - scene.origin;  // the overrides are world points; the scene may be rebased
     camera.origin += ", --eye";
   }
   if (overrides.target) {
     if (!finite(*overrides.target)) badOption("--target", "must be finite");
-    const glm::dvec3 d = *overrides.target - eye;
+    const glm::dvec3 d = (*overrides.target - scene.origin) - eye;
     if (!(glm::length(d) > 0.0)) badOption("--target", "equals the eye position " + fmt(eye));
     forward = glm::normalize(d);
     reorient = true;

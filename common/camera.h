@@ -17,6 +17,14 @@
 
 namespace rastray {
 
+// Which world point the shared triangle store is rebased on before its
+// positions are rounded to float (rebaseScene in common/scene.h).
+enum class RenderOrigin {
+  Camera,  // the camera's eye: float spacing is finest where the image is made
+  World,   // the file's own origin: no rebasing (shows the far-from-origin failure)
+};
+const char* toString(RenderOrigin origin);
+
 struct CameraOverrides {
   std::optional<glm::dvec3> eye;
   std::optional<glm::dvec3> target;
@@ -44,8 +52,11 @@ struct Camera {
   double aspect = 1.0;             // the file's aspectRatio, else width / height
   double xmag = 1.0, ymag = 1.0;   // orthographic half extents
   double znear = 0.0, zfar = 0.0;  // zfar may be +inf (perspective only)
+  // In the scene's rebased frame (Scene::origin): "world" below means that
+  // frame; worldOrigin is the file-space point its (0, 0, 0) stands for.
   glm::dmat4 worldFromView{1.0};
   glm::dmat4 viewFromWorld{1.0};
+  glm::dvec3 worldOrigin{0.0};
   std::string origin;  // where the camera came from, for `info` and reports
 
   glm::dvec3 eye() const { return glm::dvec3(worldFromView[3]); }
@@ -69,6 +80,11 @@ struct Camera {
   // eye (0, 1, 5) forward (0, 0, -1) [node 2 'Camera' (camera 0)]".
   std::string describe() const;
 };
+
+// Rebases the scene (rebaseScene) on the point `mode` names: the eye of the
+// camera makeCamera(scene, overrides, …) makes, or the file's origin. Call
+// once after loading, before the camera is made and anything is rendered.
+void applyRenderOrigin(Scene& scene, RenderOrigin mode, const CameraOverrides& overrides);
 
 // The default camera of SPEC §2 for a scene (used when it has none).
 CameraModel defaultCameraModel(const Scene& scene);

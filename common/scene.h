@@ -8,9 +8,12 @@
 //   its primitive after strip/fan triangulation. Instance i owns
 //   triangles[firstTriangle, firstTriangle + triangleCount) and
 //   vertices [firstVertex, firstVertex + vertexCount).
-// - Space: positions and normals are in world space. Positions are float
-//   (what Embree consumes); matrices are double so that flattening far
-//   from the origin adds no error beyond the final rounding to float.
+// - Space: positions and normals are in world space, translated by
+//   −Scene::origin (the render origin, rebaseScene). Flattening is done in
+//   double; positions are rounded to float (what Embree consumes) only
+//   after the render origin is subtracted, so their spacing is fine where
+//   the image is made however far the scene lies from the file's origin.
+//   Lights, the camera model and the bounds are in the same rebased frame.
 // - Winding: counter-clockwise seen from the front. When an instance's
 //   world matrix mirrors (negative determinant) the loader swaps the
 //   second and third vertex of every triangle, as glTF requires, so
@@ -167,7 +170,16 @@ struct SceneFileStats {
 struct Scene {
   std::string path;  // as given by the user, used in messages
 
-  // The triangle store (see the conventions above).
+  // The world point the store's (0, 0, 0) stands for: positions, lights,
+  // camera and bounds are relative to it (rebaseScene). (0, 0, 0) after
+  // loading.
+  glm::dvec3 origin{0.0};
+  // Flattened world positions in double, parallel to `positions`: what
+  // rebasing rounds from.
+  std::vector<glm::dvec3> worldPositions;
+
+  // The triangle store (see the conventions above). positions[i] =
+  // float(worldPositions[i] − origin), rounded to nearest.
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;    // unit; (0,0,0) where NormalSource::Flat
   std::vector<glm::vec2> texcoords;  // the set the base colour texture reads
@@ -204,9 +216,23 @@ struct Scene {
 // (SPEC §7); never returns a partially checked scene.
 Scene loadScene(const std::string& path);
 
+// Moves the scene's frame so that world point `origin` is at (0, 0, 0):
+// positions are rounded again from worldPositions, and lights, the camera
+// model, the bounds and the degenerate-triangle counts follow. Throws
+// InputError (file: the scene) when a position does not fit a float
+// relative to that origin.
+void rebaseScene(Scene& scene, const glm::dvec3& origin);
+
 // World-space geometric normal of a stored triangle (unnormalised: its
 // length is twice the area); CCW seen from the front.
 glm::dvec3 faceNormal(const Scene& scene, uint32_t instance, uint32_t tri);
+
+// SPEC §1: a stored triangle (index into Scene::triangles) whose float
+// corners span zero area covers nothing. Exact: the cross product of the
+// float edge vectors in double is zero (every product of floats is exact
+// in double). The one definition the loader, the rasterizer's setup and
+// the Embree scene share.
+bool isDegenerate(const Scene& scene, size_t storedTriangle);
 
 const char* toString(AlphaMode mode);
 const char* toString(LightType type);

@@ -565,6 +565,7 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
       fail(e + " POSITION (accessor " + std::to_string(posAccessor) + ")",
            "vertex " + std::to_string(v) + " is not finite in world space as float");
     const glm::vec3 pf(p);
+    scene_.worldPositions.push_back(p);
     scene_.positions.push_back(pf);
     scene_.bounds.extend(glm::dvec3(pf));
     glm::dvec3 n(0.0);
@@ -613,9 +614,8 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
   for (glm::uvec3 t : tris) {
     if (inst.mirrored) std::swap(t.y, t.z);  // keep CCW = front in world space
     t += glm::uvec3(inst.firstVertex);
-    const glm::dvec3 a(scene_.positions[t.x]), b(scene_.positions[t.y]), c(scene_.positions[t.z]);
-    if (glm::cross(b - a, c - a) == glm::dvec3(0.0)) ++inst.degenerateCount;
     scene_.triangles.push_back(t);
+    if (isDegenerate(scene_, scene_.triangles.size() - 1)) ++inst.degenerateCount;
   }
   inst.triangleCount = uint32_t(tris.size());
   scene_.instances.push_back(inst);
@@ -1047,6 +1047,38 @@ glm::dvec3 faceNormal(const Scene& scene, uint32_t instance, uint32_t tri) {
   const glm::uvec3 t = scene.triangle(instance, tri);
   const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
   return glm::cross(b - a, c - a);
+}
+
+bool isDegenerate(const Scene& scene, size_t storedTriangle) {
+  const glm::uvec3 t = scene.triangles[storedTriangle];
+  const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
+  return glm::cross(b - a, c - a) == glm::dvec3(0.0);
+}
+
+void rebaseScene(Scene& scene, const glm::dvec3& origin) {
+  RASTRAY_CHECK(scene.worldPositions.size() == scene.positions.size(), "rebaseScene needs worldPositions");
+  if (!(std::isfinite(origin.x) && std::isfinite(origin.y) && std::isfinite(origin.z)))
+    throw InputError("command line", "--origin", "the render origin is not finite");
+  const glm::dvec3 shift = origin - scene.origin;
+  constexpr double kFloatMax = std::numeric_limits<float>::max();
+  Bounds bounds;
+  for (size_t i = 0; i < scene.positions.size(); ++i) {
+    const glm::dvec3 p = scene.worldPositions[i] - origin;
+    if (!(std::abs(p.x) <= kFloatMax && std::abs(p.y) <= kFloatMax && std::abs(p.z) <= kFloatMax))
+      throw InputError(scene.path, "vertex " + std::to_string(i),
+                       "does not fit a float relative to the render origin");
+    scene.positions[i] = glm::vec3(p);
+    bounds.extend(glm::dvec3(scene.positions[i]));
+  }
+  scene.bounds = bounds;
+  for (Light& light : scene.lights) light.position -= shift;
+  if (scene.camera) scene.camera->worldFromCamera[3] -= glm::dvec4(shift, 0.0);
+  for (Instance& inst : scene.instances) {
+    inst.degenerateCount = 0;
+    for (uint32_t t = 0; t < inst.triangleCount; ++t)
+      if (isDegenerate(scene, inst.firstTriangle + t)) ++inst.degenerateCount;
+  }
+  scene.origin = origin;
 }
 
 std::string IgnoredFeature::describe() const {

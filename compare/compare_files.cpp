@@ -139,6 +139,8 @@ CompareResult compareFiles(const CompareInputs& in) {
   std::optional<Camera> camera;
   if (!in.scenePath.empty()) {
     scene = loadScene(in.scenePath);
+    // As `render` and `crossval` do by default (--origin camera).
+    applyRenderOrigin(*scene, RenderOrigin::Camera, in.camera);
     camera = makeCamera(*scene, in.camera, width, height);
     settings.scene = &*scene;
     settings.camera = &*camera;

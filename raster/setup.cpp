@@ -188,7 +188,7 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
             const glm::uvec3 idx = scene.triangles[inst.firstTriangle + k];
             const glm::dvec3 p[3] = {glm::dvec3(scene.positions[idx.x]), glm::dvec3(scene.positions[idx.y]),
                                      glm::dvec3(scene.positions[idx.z])};
-            if (glm::cross(p[1] - p[0], p[2] - p[0]) == glm::dvec3(0.0)) {
+            if (isDegenerate(scene, inst.firstTriangle + k)) {
               ++n.degenerate;  // SPEC §1: zero world area covers nothing
               continue;
             }

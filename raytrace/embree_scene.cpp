@@ -93,9 +93,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, const SceneAnalysis& analysis, Cull
                     "instance " + std::to_string(id) + " triangle " + std::to_string(t) +
                         " indexes a vertex outside the instance's range");
       glm::uvec3 local = tri - glm::uvec3(inst.firstVertex);
-      // The loader's degenerate test (zero cross product in double).
-      const glm::dvec3 a(scene.positions[tri.x]), b(scene.positions[tri.y]), c(scene.positions[tri.z]);
-      if (glm::cross(b - a, c - a) == glm::dvec3(0.0)) local = glm::uvec3(local.x);
+      // SPEC §1: zero area covers nothing (Embree is handed a point).
+      if (isDegenerate(scene, inst.firstTriangle + t)) local = glm::uvec3(local.x);
       indices[3 * t + 0] = local.x;
       indices[3 * t + 1] = local.y;
       indices[3 * t + 2] = local.z;

@@ -247,6 +247,10 @@ std::string fmt3(const glm::dvec3& v) {
 
 }  // namespace
 
+const char* toString(RayOffsetMethod method) {
+  return method == RayOffsetMethod::ErrorBound ? "error-bound" : "float-ulps";
+}
+
 // ---------------------------------------------------------------------------
 
 struct RayCaster::Impl {

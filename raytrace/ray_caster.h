@@ -70,8 +70,16 @@
 
 namespace rastray {
 
+// Where secondary and shadow rays start (raytrace/ray_offset.h).
+enum class RayOffsetMethod {
+  ErrorBound,  // conservative bound on the hit point's rounding error, from its triangle's vertices (pbrt-v4)
+  FloatUlps,   // a fixed count of float ULPs of the hit point's own coordinates (Ray Tracing Gems ch. 6)
+};
+const char* toString(RayOffsetMethod method);
+
 struct RayOptions {
   int spp = 1;
+  RayOffsetMethod offset = RayOffsetMethod::ErrorBound;
   ShadingOptions shading;            // maxDepth, throughput cut-off, texture filter
   float transparencyCutoff = 1e-4f;  // stop compositing once remaining transmittance is below
   bool keepSamples = false;          // fill RenderOutput::samples (deep output, crossval)

@@ -10,16 +10,13 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
-#include "gltf_writer.h"
+#include "common/gltf_writer.h"
 #include "run_command.h"
 
 namespace rastray {
 namespace {
 
 using nlohmann::json;
-using test::GltfMaterial;
-using test::GltfMesh;
-using test::GltfScene;
 using test::runRastray;
 
 std::string writeScene(const GltfScene& scene, const std::string& name) {
@@ -89,7 +86,7 @@ TEST(CrossvalCases, ManyTransparentLayersBeyondTheCutOff) {
     scene.materials.push_back(m);
     scene.meshes.push_back(quad(glm::vec3(0.0f, 0.0f, -0.01f * float(i)), 1.0f, i));
   }
-  scene.camera = test::GltfCamera{{0.3, 0.2, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.8, 0.1, {}};
+  scene.camera = GltfCamera{{0.3, 0.2, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.8, 0.1, {}};
   const std::string path = writeScene(scene, "many_layers");
   const json s = crossval(path, {"--size", "96", "64", "--spp", "1"});
   const json& v = s["rasterVsRaytrace"]["visibility"];
@@ -145,7 +142,7 @@ TEST(CrossvalCases, DuplicatedFacesAreTwoLayersSharedEdgesOne) {
   GltfMesh floor = quad(glm::vec3(0.0f, 0.0f, -1.0f), 3.0f, 2);
   scene.meshes.push_back(floor);
   scene.lights.push_back({"directional", {0.0, 0.0, 0.0}, {0.2, -0.1, -1.0}, 3.0f});
-  scene.camera = test::GltfCamera{{0.2, 0.1, 2.5}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.9, 0.1, {}};
+  scene.camera = GltfCamera{{0.2, 0.1, 2.5}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.9, 0.1, {}};
   const std::string path = writeScene(scene, "duplicated_faces");
   const json s = crossval(path, {"--size", "160", "120", "--spp", "4"});
   EXPECT_EQ(genuine(s, "rasterVsRaytrace"), 0u);
@@ -171,7 +168,7 @@ TEST(CrossvalCases, CullingAgreesOnClosedSingleSidedMeshes) {
   GltfMesh wall = quad(glm::vec3(0.0f, 0.0f, -1.5f), 3.0f, 2);
   scene.meshes.push_back(wall);
   scene.lights.push_back({"directional", {0.0, 0.0, 0.0}, {-0.3, -0.5, -1.0}, 3.0f});
-  scene.camera = test::GltfCamera{{0.0, 0.3, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.8, 0.1, {}};
+  scene.camera = GltfCamera{{0.0, 0.3, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.8, 0.1, {}};
   const std::string path = writeScene(scene, "cull_spheres");
   for (const char* mode : {"back", "front"}) {
     const json s = crossval(path, {"--size", "120", "90", "--spp", "4", "--cull", mode});
@@ -192,7 +189,7 @@ TEST(CrossvalCases, RayCasterCullsBackFaces) {
   box.indices = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
                  2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
   scene.meshes.push_back(box);
-  scene.camera = test::GltfCamera{{0.1, 0.2, 0.3}, {0.0, 0.0, -1.0}, {0.0, 1.0, 0.0}, 1.2, 0.01, {}};
+  scene.camera = GltfCamera{{0.1, 0.2, 0.3}, {0.0, 0.0, -1.0}, {0.0, 1.0, 0.0}, 1.2, 0.01, {}};
   const std::string path = writeScene(scene, "inside_box");
   for (const char* renderer : {"raster", "raytrace"}) {
     const std::string exr = std::string("inside_") + renderer + "_" + std::to_string(getpid()) + ".exr";

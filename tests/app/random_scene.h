@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-#include "gltf_writer.h"
+#include "common/gltf_writer.h"
 
 namespace rastray::test {
 

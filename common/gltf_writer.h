@@ -1,5 +1,5 @@
-// Writes small glTF 2.0 files from code, for tests that run the real binary
-// on generated scenes (regression cases and random scenes): positions and
+// Writes small glTF 2.0 files from code: the generated scenes of tests
+// (regression cases, random scenes) and of `rastray stability`. Positions and
 // uint32 indices in one base64 data-URI buffer, metallic-roughness
 // materials with KHR_materials_transmission/ior, one optional camera
 // (placed by eye/target/up) and KHR_lights_punctual lights.
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace rastray::test {
+namespace rastray {
 
 struct GltfMaterial {
   glm::vec4 baseColor{1.0f};
@@ -59,4 +59,4 @@ struct GltfScene {
 // major 4×4 matrix as glTF's "matrix".
 std::vector<double> lookAtNodeMatrix(const glm::dvec3& eye, const glm::dvec3& forward, glm::dvec3 up);
 
-}  // namespace rastray::test
+}  // namespace rastray

@@ -1,4 +1,4 @@
-#include "gltf_writer.h"
+#include "common/gltf_writer.h"
 
 #include <cmath>
 #include <cstring>
@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-namespace rastray::test {
+namespace rastray {
 
 namespace {
 
@@ -143,4 +143,4 @@ void GltfScene::write(const std::string& path) const {
   if (!out) throw std::runtime_error("cannot write " + path);
 }
 
-}  // namespace rastray::test
+}  // namespace rastray
