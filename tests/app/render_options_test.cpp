@@ -52,6 +52,7 @@ const std::vector<Expected> kExpected = {
     {"--threads", kAllRenderers, OptionCondition::Always, {"1"}},
     {"--debug-pixel", kAllRenderers, OptionCondition::Always, {"1", "1"}},
     {"--texture-filter", kAllRenderers, OptionCondition::Always, {"nearest"}},
+    {"--origin", kAllRenderers, OptionCondition::Always, {"world"}},
     {"--cull", kAllRenderers, OptionCondition::Always, {"back"}},
     {"--shadows", kAllRenderers, OptionCondition::Always, {}},  // value: see valueFor
     {"--depth-format", kRaster | kHybrid, OptionCondition::Always, {"float"}},
@@ -65,6 +66,7 @@ const std::vector<Expected> kExpected = {
     {"--shadow-bias", kRaster | kHybrid, OptionCondition::ShadowMaps, {"1", "1"}},
     {"--max-depth", kRaytrace | kHybrid, OptionCondition::Always, {"2"}},
     {"--transparency-cutoff", kRaytrace | kHybrid, OptionCondition::Always, {"0.01"}},
+    {"--ray-offset", kRaytrace | kHybrid, OptionCondition::Always, {"float-ulps"}},
     {"--no-packets", kRaytrace, OptionCondition::Always, {}},
 };
 
