@@ -1,0 +1,111 @@
+// The measurement toolkit every stability case uses: parse render options
+// the way `rastray render` / `crossval` do, load and render one variant of a
+// case, count NaN / Inf, compare visibility against a reference render or
+// the ray caster, measure colour differences, and write the report's images.
+// Kept small on purpose: a case reads as "render these variants, measure
+// these numbers, assert this property".
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "app/crossval.h"
+#include "app/render_setup.h"
+#include "app/stability.h"
+#include "common/image.h"
+#include "common/render_output.h"
+#include "common/scene.h"
+#include "compare/visibility.h"
+
+namespace rastray::stability {
+
+// Render options exactly as the command line gives them to `rastray render`
+// (allRenderers false: "--renderer X" among them) or `crossval`
+// (allRenderers true): registered with addRenderSettings, parsed by CLI11,
+// checked and completed by RenderSettings::finish(). Throws InputError
+// (file "command line") or CLI::ParseError on a bad list: a case with a bad
+// option is a bug in the case, and the command reports it (exit 2).
+// The result's cliOptions are cleared (they point into a parser that is gone).
+RenderSettings renderSettingsFrom(const std::vector<std::string>& args, bool allRenderers = false);
+
+// One variant of a case: the scene loaded and rebased for its settings
+// (loadSceneForRender: --origin decides the frame), the render, and the
+// settings used. run.camera is the camera in the scene's rebased frame;
+// run.seconds the frame time (rendering only, not loading).
+struct Rendered {
+  RenderSettings settings;
+  Scene scene;
+  RenderRun run;
+  const Camera& camera() const { return run.camera; }
+  const FlatImage& image() const { return run.output.image; }
+  double seconds() const { return run.seconds; }
+};
+
+// Loads `scenePath` for the options `args` (render syntax, "--renderer X"
+// included) and renders it; deep = true keeps every sample and layer
+// (run.output.samples), which the visibility comparisons need. Reports
+// "<label>: <seconds> s" through ctx.progress when it is set.
+Rendered renderVariant(const CaseContext& ctx, const std::string& scenePath,
+                       const std::vector<std::string>& args, bool deep = true, const std::string& label = "");
+
+// NaN or infinite values in a render: every colour channel of the image and
+// of the deep samples, and every depth that is NaN, −inf, or +inf on a hit
+// (+inf where nothing was hit is the SPEC §4 background, not an error).
+uint64_t countNanInf(const RenderOutput& output);
+
+// Visibility of `a` against `reference`, both deep (renderVariant with deep
+// = true), same size and spp, same instance / triangle numbering (the same
+// scene, or the same scene moved). Mismatches are classified as crossval
+// does (compare/classify.h) against the reference's scene and camera: the
+// geometry the reference shows is what `a` should show. The depth format
+// deciding a depth tie is a's rasterizer depth format when a rasterizes
+// (raster, hybrid), else the reference's, else float-reversed.
+VisibilityReport visibilityAgainst(const Rendered& a, const Rendered& reference);
+
+// Shorthands on a report: the fraction of compared layers whose hits agree,
+// and the number of genuine mismatching layers.
+double agreementOf(const VisibilityReport& v);
+int64_t genuineOf(const VisibilityReport& v);
+
+// Every renderer on one scene, as `rastray crossval` runs it (args in
+// crossval syntax, no --renderer): raster and hybrid against the ray caster.
+// Reports each stage through ctx.progress.
+CrossvalResult crossvalidateVariant(const CaseContext& ctx, const std::string& scenePath,
+                                    const std::vector<std::string>& args);
+
+// Colour difference of two same-size flat images: the largest |A − B| over
+// the RGBA channels of each pixel (linear, premultiplied, as rendered).
+// fractionOff: the share of pixels where it exceeds `threshold`.
+std::vector<float> pixelDifference(const FlatImage& a, const FlatImage& b);
+double fractionOff(const FlatImage& a, const FlatImage& b, double threshold);
+
+// A report image: (path relative to CaseContext::reportDir, caption), the
+// form of Row::images. Every writer below puts its file at
+// <reportDir>/<caseName>/<file> (file: a name ending in .png) and returns the
+// entry; with an empty reportDir it writes nothing and returns an empty
+// path. addImage appends an entry to a row unless its path is empty.
+using ReportImage = std::pair<std::string, std::string>;
+void addImage(Row& row, const ReportImage& image);
+
+// The render itself (sRGB PNG, common/image.h writePng).
+ReportImage writeRenderImage(const CaseContext& ctx, const std::string& caseName, const std::string& file,
+                             const FlatImage& image, const std::string& caption);
+// Heat map of pixelDifference(a, b) (compare/maps.h); the caption gets the
+// colour bar's range appended.
+ReportImage writeDifferenceImage(const CaseContext& ctx, const std::string& caseName, const std::string& file,
+                                 const FlatImage& a, const FlatImage& b, const std::string& caption);
+// The visibility-mismatch map, one colour per class (compare/maps.h legend).
+ReportImage writeMismatchImage(const CaseContext& ctx, const std::string& caseName, const std::string& file,
+                               const VisibilityReport& visibility, const std::string& caption);
+// Heat map of arbitrary per-pixel values (NaN: no value), e.g. acne and leak
+// counts per pixel.
+ReportImage writeValueImage(const CaseContext& ctx, const std::string& caseName, const std::string& file,
+                            int width, int height, const std::vector<float>& values,
+                            const std::string& quantity, const std::string& caption);
+
+// "1e-05", "1e+06": how case names and variant labels print a power of ten.
+std::string powerOfTen(double value);
+
+}  // namespace rastray::stability
