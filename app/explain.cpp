@@ -100,6 +100,12 @@ std::string explainPixel(const Scene& scene, const RenderSettings& settings, int
                 scene.path.c_str(), raster.camera.width, raster.camera.height, s.spp,
                 raster.camera.describe().c_str());
   out += line;
+  if (scene.origin != glm::dvec3(0.0)) {
+    // Traced ray origins below are in the rebased frame (--origin camera).
+    std::snprintf(line, sizeof line, "positions below are relative to the render origin (%.17g, %.17g, %.17g)\n\n",
+                  scene.origin.x, scene.origin.y, scene.origin.z);
+    out += line;
+  }
 
   // Hits side by side, with the mismatch class of each disagreement.
   ClassifierSettings cs;
