@@ -1,10 +1,14 @@
 #include "common/gltf_writer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 
 namespace rastray {
 
@@ -33,6 +37,20 @@ void append(std::vector<unsigned char>* bytes, const T* data, size_t count) {
   std::memcpy(bytes->data() + at, data, count * sizeof(T));
 }
 
+// An 8-bit RGB PNG in memory (OpenImageIO, no file).
+std::vector<unsigned char> encodePng(const GltfTexture& t) {
+  if (t.width < 1 || t.height < 1 || t.rgb.size() != size_t(t.width) * size_t(t.height) * 3)
+    throw std::runtime_error("gltf_writer: texture size does not match its pixels");
+  std::vector<unsigned char> png;
+  OIIO::Filesystem::IOVecOutput proxy(png);
+  auto out = OIIO::ImageOutput::create("texture.png", &proxy);
+  const OIIO::ImageSpec spec(t.width, t.height, 3, OIIO::TypeDesc::UINT8);
+  if (!out || !out->open("texture.png", spec) || !out->write_image(OIIO::TypeDesc::UINT8, t.rgb.data()) ||
+      !out->close())
+    throw std::runtime_error("gltf_writer: cannot encode a texture as PNG");
+  return png;
+}
+
 }  // namespace
 
 std::vector<double> lookAtNodeMatrix(const glm::dvec3& eye, const glm::dvec3& forward, glm::dvec3 up) {
@@ -50,22 +68,35 @@ std::string GltfScene::toJson() const {
   std::vector<unsigned char> bytes;
   json accessors = json::array(), views = json::array(), meshesJson = json::array(), nodes = json::array();
   json sceneNodes = json::array();
+  // One float accessor over `count` elements of `components` floats.
+  auto floatAccessor = [&](const float* data, size_t count, int components, const char* type, bool bounds) {
+    const size_t offset = bytes.size();
+    append(&bytes, data, count * size_t(components));
+    views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", count * size_t(components) * 4}});
+    json a = {{"bufferView", views.size() - 1}, {"componentType", 5126}, {"count", count}, {"type", type}};
+    if (bounds) {
+      std::vector<float> lo(size_t(components), INFINITY), hi(size_t(components), -INFINITY);
+      for (size_t i = 0; i < count; ++i)
+        for (int c = 0; c < components; ++c) {
+          lo[size_t(c)] = std::min(lo[size_t(c)], data[i * size_t(components) + size_t(c)]);
+          hi[size_t(c)] = std::max(hi[size_t(c)], data[i * size_t(components) + size_t(c)]);
+        }
+      a["min"] = lo;
+      a["max"] = hi;
+    }
+    accessors.push_back(a);
+    return accessors.size() - 1;
+  };
   for (const GltfMesh& m : meshes) {
     if (m.positions.empty() || m.indices.empty()) throw std::runtime_error("gltf_writer: empty mesh");
-    glm::vec3 lo(INFINITY), hi(-INFINITY);
-    for (const glm::vec3& p : m.positions) {
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
-    }
-    const size_t positionOffset = bytes.size();
-    append(&bytes, &m.positions[0].x, m.positions.size() * 3);
-    views.push_back({{"buffer", 0}, {"byteOffset", positionOffset}, {"byteLength", m.positions.size() * 12}});
-    accessors.push_back({{"bufferView", views.size() - 1},
-                         {"componentType", 5126},
-                         {"count", m.positions.size()},
-                         {"type", "VEC3"},
-                         {"min", {lo.x, lo.y, lo.z}},
-                         {"max", {hi.x, hi.y, hi.z}}});
+    if ((!m.normals.empty() && m.normals.size() != m.positions.size()) ||
+        (!m.texcoords.empty() && m.texcoords.size() != m.positions.size()))
+      throw std::runtime_error("gltf_writer: normals or texcoords do not match the positions");
+    json attributes = {{"POSITION", floatAccessor(&m.positions[0].x, m.positions.size(), 3, "VEC3", true)}};
+    if (!m.normals.empty())
+      attributes["NORMAL"] = floatAccessor(&m.normals[0].x, m.normals.size(), 3, "VEC3", false);
+    if (!m.texcoords.empty())
+      attributes["TEXCOORD_0"] = floatAccessor(&m.texcoords[0].x, m.texcoords.size(), 2, "VEC2", false);
     const size_t indexOffset = bytes.size();
     append(&bytes, m.indices.data(), m.indices.size());
     views.push_back({{"buffer", 0}, {"byteOffset", indexOffset}, {"byteLength", m.indices.size() * 4}});
@@ -73,10 +104,9 @@ std::string GltfScene::toJson() const {
                          {"componentType", 5125},
                          {"count", m.indices.size()},
                          {"type", "SCALAR"}});
-    meshesJson.push_back({{"primitives",
-                           {{{"attributes", {{"POSITION", accessors.size() - 2}}},
-                             {"indices", accessors.size() - 1},
-                             {"material", m.material}}}}});
+    meshesJson.push_back(
+        {{"primitives",
+          {{{"attributes", attributes}, {"indices", accessors.size() - 1}, {"material", m.material}}}}});
     json node = {{"mesh", meshesJson.size() - 1}};
     if (m.translation != glm::dvec3(0.0))
       node["translation"] = {m.translation.x, m.translation.y, m.translation.z};
@@ -93,6 +123,11 @@ std::string GltfScene::toJson() const {
               {"alphaMode", m.alphaMode},
               {"doubleSided", m.doubleSided}};
     if (m.alphaMode == "MASK") j["alphaCutoff"] = m.alphaCutoff;
+    if (m.baseColorTexture >= 0) {
+      if (size_t(m.baseColorTexture) >= textures.size())
+        throw std::runtime_error("gltf_writer: material names a texture that does not exist");
+      j["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", m.baseColorTexture}, {"texCoord", 0}};
+    }
     if (m.transmission > 0.0f) {
       transmission = true;
       j["extensions"] = {{"KHR_materials_transmission", {{"transmissionFactor", m.transmission}}},
@@ -109,12 +144,31 @@ std::string GltfScene::toJson() const {
       {"bufferViews", views},
       {"buffers",
        {{{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}}}}};
+  if (!textures.empty()) {
+    json images = json::array(), samplers = json::array(), texturesJson = json::array();
+    for (const GltfTexture& t : textures) {
+      images.push_back({{"mimeType", "image/png"}, {"uri", "data:image/png;base64," + base64(encodePng(t))}});
+      samplers.push_back(
+          {{"magFilter", t.magFilter}, {"minFilter", t.minFilter}, {"wrapS", t.wrapS}, {"wrapT", t.wrapT}});
+      texturesJson.push_back({{"sampler", samplers.size() - 1}, {"source", images.size() - 1}});
+    }
+    doc["images"] = images;
+    doc["samplers"] = samplers;
+    doc["textures"] = texturesJson;
+  }
   json used = json::array();
   if (transmission) used.insert(used.end(), {"KHR_materials_transmission", "KHR_materials_ior"});
   if (camera) {
-    json perspective = {{"yfov", camera->yfov}, {"znear", camera->znear}};
-    if (camera->zfar) perspective["zfar"] = *camera->zfar;
-    doc["cameras"] = {{{"type", "perspective"}, {"perspective", perspective}}};
+    if (camera->orthographic) {
+      if (!camera->zfar) throw std::runtime_error("gltf_writer: an orthographic camera needs zfar");
+      json orthographic = {
+          {"xmag", camera->xmag}, {"ymag", camera->ymag}, {"znear", camera->znear}, {"zfar", *camera->zfar}};
+      doc["cameras"] = {{{"type", "orthographic"}, {"orthographic", orthographic}}};
+    } else {
+      json perspective = {{"yfov", camera->yfov}, {"znear", camera->znear}};
+      if (camera->zfar) perspective["zfar"] = *camera->zfar;
+      doc["cameras"] = {{{"type", "perspective"}, {"perspective", perspective}}};
+    }
     nodes.push_back(
         {{"camera", 0}, {"matrix", lookAtNodeMatrix(camera->eye, camera->target - camera->eye, camera->up)}});
     sceneNodes.push_back(nodes.size() - 1);

@@ -1,8 +1,10 @@
 // Writes small glTF 2.0 files from code: the generated scenes of tests
-// (regression cases, random scenes) and of `rastray stability`. Positions and
-// uint32 indices in one base64 data-URI buffer, metallic-roughness
-// materials with KHR_materials_transmission/ior, one optional camera
-// (placed by eye/target/up) and KHR_lights_punctual lights.
+// (regression cases, random scenes) and of `rastray stability`. Positions,
+// optional normals and texcoords, and uint32 indices in one base64 data-URI
+// buffer; metallic-roughness materials with an optional base colour texture
+// (8-bit RGB, embedded as a data-URI PNG) and KHR_materials_transmission/ior;
+// one optional perspective or orthographic camera (placed by
+// eye/target/up) and KHR_lights_punctual lights.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -20,21 +22,35 @@ struct GltfMaterial {
   bool doubleSided = false;
   float transmission = 0.0f;  // > 0 writes KHR_materials_transmission (and ior)
   float ior = 1.5f;
+  int baseColorTexture = -1;  // index into GltfScene::textures, read through TEXCOORD_0; -1: none
+};
+
+// An 8-bit RGB image (row 0 at the top, v = 0) with its glTF sampler.
+struct GltfTexture {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;    // width·height·3 bytes
+  int magFilter = 9729;              // LINEAR
+  int minFilter = 9987;              // LINEAR_MIPMAP_LINEAR
+  int wrapS = 10497, wrapT = 10497;  // REPEAT
 };
 
 // One mesh with one TRIANGLES primitive, on its own node.
 struct GltfMesh {
   std::vector<glm::vec3> positions;
-  std::vector<uint32_t> indices;  // three per triangle
+  std::vector<uint32_t> indices;     // three per triangle
+  std::vector<glm::vec3> normals;    // empty, or one per position (NORMAL)
+  std::vector<glm::vec2> texcoords;  // empty, or one per position (TEXCOORD_0)
   int material = 0;
   glm::dvec3 translation{0.0};  // the node's translation (kept exact in the file)
 };
 
 struct GltfCamera {
   glm::dvec3 eye{0.0, 0.0, 3.0}, target{0.0}, up{0.0, 1.0, 0.0};
-  double yfov = 0.8;  // radians
+  bool orthographic = false;
+  double yfov = 0.8;              // radians (perspective)
+  double xmag = 1.0, ymag = 1.0;  // half extents (orthographic)
   double znear = 0.1;
-  std::optional<double> zfar;  // absent: infinite
+  std::optional<double> zfar;  // absent: infinite (perspective; orthographic requires it)
 };
 
 struct GltfLight {
@@ -46,6 +62,7 @@ struct GltfLight {
 
 struct GltfScene {
   std::vector<GltfMaterial> materials;
+  std::vector<GltfTexture> textures;
   std::vector<GltfMesh> meshes;
   std::optional<GltfCamera> camera;
   std::vector<GltfLight> lights;
