@@ -15,5 +15,6 @@ CommandRunner addRenderCommand(CLI::App& app);
 CommandRunner addCrossvalCommand(CLI::App& app);
 CommandRunner addExplainCommand(CLI::App& app);
 CommandRunner addCompareCommand(CLI::App& app);
+CommandRunner addStabilityCommand(CLI::App& app);
 
 }  // namespace rastray

@@ -10,8 +10,6 @@
 
 namespace rastray {
 
-namespace {
-
 std::string escapeHtml(const std::string& s) {
   std::string out;
   for (char c : s) {
@@ -35,6 +33,8 @@ std::string escapeHtml(const std::string& s) {
   return out;
 }
 
+namespace {
+
 std::string fmt(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
@@ -43,8 +43,10 @@ std::string fmt(const char* format, double v) {
 
 std::string percent(double fraction) { return fmt("%.4f %%", 100.0 * fraction); }
 
+}  // namespace
+
 // One page style for every page: no external resources.
-const char* kStyle = R"(<style>
+const char* const kStyle = R"(<style>
 body{font-family:system-ui,-apple-system,"Segoe UI",sans-serif;margin:24px;color:#1d1d1f;background:#fafafa}
 h1{font-size:22px}h2{font-size:18px;margin-top:28px}h3{font-size:15px}
 table{border-collapse:collapse;margin:8px 0;font-size:13px}
@@ -60,10 +62,20 @@ img.px{image-rendering:pixelated;display:block;background:repeating-conic-gradie
 code,pre{font-size:12px}pre{background:#fff;border:1px solid #ddd;padding:8px;overflow-x:auto}
 </style>)";
 
-std::string page(const std::string& title, const std::string& body) {
+std::string reportPage(const std::string& title, const std::string& body) {
   return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escapeHtml(title) +
          "</title>" + kStyle + "</head><body>\n" + body + "\n</body></html>\n";
 }
+
+std::string mismatchLegendHtml() {
+  std::string s;
+  for (const LegendEntry& e : mismatchLegend())
+    s += "<div><span class=\"swatch\" style=\"background:" + cssColor(e.srgb) + "\"></span>" +
+         escapeHtml(e.label) + "</div>";
+  return s;
+}
+
+namespace {
 
 // Images are shown at a display size that keeps small renders visible.
 std::string figure(const std::string& src, const std::string& caption, int width, int height) {
@@ -77,14 +89,6 @@ std::string colorBarHtml(const ColorBar& bar) {
   return "<div class=\"bar\" style=\"background:" + bar.cssGradient() +
          "\"></div><div class=\"barlabels\"><span>" + fmt("%.3g", bar.lo) + "</span><span>" +
          escapeHtml(bar.quantity) + "</span><span>" + fmt("%.3g", bar.hi) + "</span></div>";
-}
-
-std::string legendHtml() {
-  std::string s;
-  for (const LegendEntry& e : mismatchLegend())
-    s += "<div><span class=\"swatch\" style=\"background:" + cssColor(e.srgb) + "\"></span>" +
-         escapeHtml(e.label) + "</div>";
-  return s;
 }
 
 std::string countersTable(const CrossvalResult& r) {
@@ -190,7 +194,7 @@ void writeScenePage(const std::string& dir, const CrossvalResult& r,
        "</div>";
   b += "<h2>Where visibility differs</h2><div class=\"row\">" +
        figure("mismatch.png", "rasterizer vs ray caster, each pixel's most severe class", w, h) +
-       figure("mismatch-hybrid.png", "hybrid vs ray caster", w, h) + "<figure>" + legendHtml() +
+       figure("mismatch-hybrid.png", "hybrid vs ray caster", w, h) + "<figure>" + mismatchLegendHtml() +
        "</figure></div>";
   b += visibilityTable(r.rasterVsRay, "raster", "raytrace");
   b += visibilityTable(r.hybridVsRay, "hybrid", "raytrace");
@@ -233,7 +237,7 @@ void writeScenePage(const std::string& dir, const CrossvalResult& r,
            "</td></tr>";
   }
   b += "</table>";
-  writeTextFile(dir + "/index.html", page(sceneName(r) + " - rastray crossval", b));
+  writeTextFile(dir + "/index.html", reportPage(sceneName(r) + " - rastray crossval", b));
 }
 
 }  // namespace
@@ -254,7 +258,8 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
   b += "<table><tr><th class=\"l\">scene</th><th>size</th><th>samples</th><th>layers</th><th>agree</th>";
   for (int c = 0; c < kMismatchClassCount; ++c)
     b += "<th>" + std::string(displayName(MismatchClass(c))) + "</th>";
-  b += "<th>cut off</th><th>max rel &Delta;Z</th><th>RMS</th><th>PSNR</th><th>hybrid &Delta; where hits agree</th>"
+  b += "<th>cut off</th><th>max rel &Delta;Z</th><th>RMS</th><th>PSNR</th><th>hybrid &Delta; where hits "
+       "agree</th>"
        "<th>raster s</th><th>raytrace s</th><th>hybrid s</th></tr>";
   for (size_t i = 0; i < results.size(); ++i) {
     const CrossvalResult& r = results[i];
@@ -281,7 +286,7 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
          fmt("%.3f", r.raster.seconds) + "</td><td>" + fmt("%.3f", r.raytrace.seconds) + "</td><td>" +
          fmt("%.3f", r.hybrid.seconds) + "</td></tr>";
   }
-  b += "</table><h2>Mismatch classes</h2>" + legendHtml();
+  b += "</table><h2>Mismatch classes</h2>" + mismatchLegendHtml();
   b += "<p>Shared-edge tie: both renderers hit triangles of one instance that share an edge, at a sample "
        "within "
        "the edge distance of it (SPEC 3 lets either win). Depth tie: |&Delta;Z| within the depth format's "
@@ -291,7 +296,7 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
        "layers behind the point where one renderer declared it stopped looking (a transmittance cut-off "
        "or a layer limit); they are counted apart, neither agreement nor mismatch, with their share of "
        "the colour.</p>";
-  writeTextFile(dir + "/index.html", page("rastray crossval", b));
+  writeTextFile(dir + "/index.html", reportPage("rastray crossval", b));
 }
 
 }  // namespace rastray

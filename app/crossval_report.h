@@ -20,6 +20,13 @@ struct ReportExplanation {
 // Writes DIR/index.html and DIR/<scene name>/...; every file atomically.
 // `explanations` (per scene, may be empty) link mismatch classes to
 // `rastray explain` output already written into the scene folders.
+// HTML pieces the other reports (rastray stability) share, so every page
+// looks alike: text escaped for HTML; a complete page with the house style
+// (no external resources); the mismatch-map legend (compare/maps.h colours).
+std::string escapeHtml(const std::string& s);
+std::string reportPage(const std::string& title, const std::string& body);
+std::string mismatchLegendHtml();
+
 void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResult>& results,
                          const RenderSettings& settings,
                          const std::vector<std::vector<ReportExplanation>>& explanations);

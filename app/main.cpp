@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   commands.push_back(addRenderCommand(app));
   commands.push_back(addCrossvalCommand(app));
   commands.push_back(addExplainCommand(app));
+  commands.push_back(addStabilityCommand(app));
 #endif
   commands.push_back(addCompareCommand(app));
 
