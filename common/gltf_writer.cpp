@@ -123,6 +123,7 @@ std::string GltfScene::toJson() const {
               {"alphaMode", m.alphaMode},
               {"doubleSided", m.doubleSided}};
     if (m.alphaMode == "MASK") j["alphaCutoff"] = m.alphaCutoff;
+    if (m.emissive != glm::vec3(0.0f)) j["emissiveFactor"] = {m.emissive.r, m.emissive.g, m.emissive.b};
     if (m.baseColorTexture >= 0) {
       if (size_t(m.baseColorTexture) >= textures.size())
         throw std::runtime_error("gltf_writer: material names a texture that does not exist");

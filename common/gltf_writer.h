@@ -2,7 +2,8 @@
 // (regression cases, random scenes) and of `rastray stability`. Positions,
 // optional normals and texcoords, and uint32 indices in one base64 data-URI
 // buffer; metallic-roughness materials with an optional base colour texture
-// (8-bit RGB, embedded as a data-URI PNG) and KHR_materials_transmission/ior;
+// (8-bit RGB, embedded as a data-URI PNG), an emissive factor and
+// KHR_materials_transmission/ior;
 // one optional perspective or orthographic camera (placed by
 // eye/target/up) and KHR_lights_punctual lights.
 #pragma once
@@ -23,6 +24,7 @@ struct GltfMaterial {
   float transmission = 0.0f;  // > 0 writes KHR_materials_transmission (and ior)
   float ior = 1.5f;
   int baseColorTexture = -1;  // index into GltfScene::textures, read through TEXCOORD_0; -1: none
+  glm::vec3 emissive{0.0f};   // emissiveFactor, each in [0, 1]; written when not black
 };
 
 // An 8-bit RGB image (row 0 at the top, v = 0) with its glTF sampler.

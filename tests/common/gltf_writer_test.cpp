@@ -87,6 +87,22 @@ TEST(GltfWriter, NormalsTexcoordsTextureAndOrthographicCameraReadBackExactly) {
   EXPECT_EQ(glm::dvec3(s.camera->worldFromCamera[3]), glm::dvec3(0, 0, 3));
 }
 
+TEST(GltfWriter, EmissiveFactorReadsBackExactly) {
+  const std::string path = tempPath("emissive.gltf");
+  GltfScene written = texturedQuad();
+  written.materials[0].baseColorTexture = -1;
+  written.materials[0].emissive = {0.1f, 1.0f, 1e-6f};  // float values, not decimal ones
+  written.materials.push_back(GltfMaterial{});          // black: no emissiveFactor written
+  written.meshes.push_back(written.meshes[0]);
+  written.meshes[1].material = 1;
+  written.write(path);
+  const Scene s = loadScene(path);
+  std::remove(path.c_str());
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].emissive, glm::vec3(0.1f, 1.0f, 1e-6f));
+  EXPECT_EQ(s.materials[1].emissive, glm::vec3(0.0f));
+}
+
 TEST(GltfWriter, RefusesWhatGltfCannotSay) {
   GltfScene s = texturedQuad();
   s.camera->zfar.reset();  // orthographic cameras have a far plane in glTF
