@@ -48,11 +48,12 @@ struct GltfMesh {
 
 struct GltfCamera {
   glm::dvec3 eye{0.0, 0.0, 3.0}, target{0.0}, up{0.0, 1.0, 0.0};
-  bool orthographic = false;
-  double yfov = 0.8;              // radians (perspective)
-  double xmag = 1.0, ymag = 1.0;  // half extents (orthographic)
+  double yfov = 0.8;  // radians (perspective)
   double znear = 0.1;
   std::optional<double> zfar;  // absent: infinite (perspective; orthographic requires it)
+  // Last, so that aggregate initialisers written before it still compile.
+  bool orthographic = false;
+  double xmag = 1.0, ymag = 1.0;  // half extents (orthographic)
 };
 
 struct GltfLight {

@@ -121,6 +121,23 @@ double planeTolerance(StoredDepthFormat format, const DepthPlanes& planes, doubl
   return depthResolution(format, planes, plane) + ulp32(plane);
 }
 
+double floatIntersectionError(const Scene& scene, uint32_t instance, uint32_t triangle, const Ray& ray,
+                              double t) {
+  const glm::uvec3 idx = scene.triangle(instance, triangle);
+  const glm::dvec3 v0(scene.positions[idx.x]), v1(scene.positions[idx.y]), v2(scene.positions[idx.z]);
+  const glm::dvec3 e1 = v0 - v1, e2 = v2 - v0, ng = glm::cross(e1, e2);
+  const double area2 = glm::length(ng);
+  if (!(area2 > 0.0)) return kInf;
+  const double cosine = std::fabs(glm::dot(ng, ray.direction)) / area2;
+  if (!(cosine > 0.0)) return kInf;
+  constexpr double kEps = 0x1p-24;  // float unit roundoff
+  // Relative error of the float normal's direction: 2ε|e1||e2| / |e1 × e2|
+  // (1/sin of the corner angle, large for slivers), counted in both dots.
+  const double normalError = 2.0 * kEps * glm::length(e1) * glm::length(e2) / area2;
+  const double reach = std::max(1.0, glm::length(v0 - ray.origin) / std::max(t, 1e-300));
+  return t * (7.0 * kEps + 2.0 * normalError) * reach / cosine;
+}
+
 MismatchClassifier::MismatchClassifier(const ClassifierSettings& settings) : settings_(settings) {}
 
 bool MismatchClassifier::isDepthTie(const HitRecord& a, const HitRecord& b) const {
@@ -146,7 +163,10 @@ bool MismatchClassifier::isGeometricDepthTie(glm::dvec2 sample, const HitRecord&
   if (!inside(baryA) || !inside(baryB)) return false;
   const double dA = tA * ray.depthPerT, dB = tB * ray.depthPerT;
   if (!(dA > 0.0) || !(dB > 0.0) || !std::isfinite(dA) || !std::isfinite(dB)) return false;
-  return std::fabs(dA - dB) <= depthTieTolerance(settings_.depthFormat, settings_.planes, dA, dB);
+  const double rayError = std::max(floatIntersectionError(*settings_.scene, a.instance, a.triangle, ray, tA),
+                                   floatIntersectionError(*settings_.scene, b.instance, b.triangle, ray, tB));
+  return std::fabs(dA - dB) <=
+         depthTieTolerance(settings_.depthFormat, settings_.planes, dA, dB) + rayError * ray.depthPerT;
 }
 
 bool MismatchClassifier::touchesNearOrFarPlane(const HitRecord& h) const {

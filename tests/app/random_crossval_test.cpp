@@ -81,10 +81,11 @@ TEST(RandomCrossval, TwoHundredSeedsHaveNoGenuineMismatches) {
 
 // Seeds that found bugs, now fixed: coincident duplicated faces (ray caster
 // merged them; layers ordered differently; Embree's float t outside the
-// depth-tie tolerance), a silhouette miss cascading into the layers behind,
+// depth-tie tolerance; seed 23: nearly coplanar triangles seen at 84°, within
+// the float intersection bound but not the format's), a silhouette miss cascading into the layers behind,
 // grazing triangles cut by a finite far plane (the cut is an edge too).
 TEST(RandomCrossval, SeedsThatFoundBugs) {
-  const auto failures = crossvalSeeds({39, 47, 53, 97, 119, 132, 166, 172, 186, 190},
+  const auto failures = crossvalSeeds({23, 39, 47, 53, 97, 119, 132, 166, 172, 186, 190},
                                       {"--size", "80", "60", "--spp", "4", "--shadow-map-size", "64"});
   EXPECT_TRUE(failures.empty()) << joined(failures);
 }

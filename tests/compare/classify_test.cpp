@@ -132,6 +132,33 @@ TEST(Classifier, PerspectiveEdgeProjection) {
   EXPECT_NEAR(c.distanceToTriangleEdges({4.03, 4.0}, hit(0, 0, 2.0f)), 0.03, 1e-9);
 }
 
+// The float intersection bound grows as 1/cos θ towards grazing incidence
+// and with the triangle's thinness, and is a few ULPs of t head-on.
+TEST(Classifier, FloatIntersectionErrorGrowsAtGrazingAndForSlivers) {
+  Scene s;
+  s.path = "bound";
+  s.positions = {{-1.0f, -1.0f, -2.0f}, {1.0f, -1.0f, -2.0f}, {0.0f, 1.0f, -2.0f},
+                 {-1.0f, 0.0f, -2.0f}, {1.0f, 0.0f, -2.0f}, {1.0f, 1e-4f, -2.0f}};
+  s.triangles = {{0, 1, 2}, {3, 4, 5}};
+  Instance inst;
+  inst.vertexCount = 6;
+  inst.triangleCount = 2;
+  s.instances = {inst};
+  s.materials = {Material{}};
+  Ray ray;
+  ray.direction = {0.0, 0.0, -1.0};
+  const double headOn = floatIntersectionError(s, 0, 0, ray, 2.0);
+  EXPECT_GT(headOn, 2.0 * 0x1p-24);
+  EXPECT_LT(headOn, 2.0 * 64.0 * 0x1p-24);
+  const double angle = std::acos(0.01);  // 89.4° from the normal
+  ray.direction = {std::sin(angle), 0.0, -std::cos(angle)};
+  EXPECT_NEAR(floatIntersectionError(s, 0, 0, ray, 2.0) / headOn, 100.0, 1.0);
+  ray.direction = {0.0, 0.0, -1.0};
+  EXPECT_GT(floatIntersectionError(s, 0, 1, ray, 2.0), 1000.0 * headOn);  // aspect 2e4 sliver
+  ray.direction = {1.0, 0.0, 0.0};  // parallel to the plane
+  EXPECT_TRUE(std::isinf(floatIntersectionError(s, 0, 0, ray, 2.0)));
+}
+
 TEST(Classifier, DepthTieFollowsTheFormat) {
   ClassifierSettings settings;
   settings.planes = {true, Projection::Orthographic, 0.125, 1.0};
