@@ -207,11 +207,13 @@ Stack extremeLayers(float alpha) {
 // --- near plane and w = 0 ---------------------------------------------------------------
 //
 // Camera at the origin looking down −Z (yfov 60°, znear 0.1, infinite far).
-// Opaque emissive triangles: one with a vertex 5 behind the eye; a floor
-// spanning 2e6 through the eye plane (vertices at z = ±1e6); one with a
-// vertex exactly on the eye plane (w = 0) beside the eye; one with a vertex
-// at the eye itself (w = 0 and x = y = 0). The rasterizer clips them in
-// homogeneous space; the ray caster intersects the world triangles.
+// Opaque emissive triangles: one with a vertex 3 behind the eye (a ceiling
+// over the top of the view, cut by the near plane); a floor spanning 2e6
+// through the eye plane (vertices at z = ±1e6); one with a vertex exactly
+// on the eye plane (w = 0) beside the eye; one with a vertex at the eye
+// itself (w = 0 and x = y = 0: its plane holds the eye, so it is seen
+// edge-on and must cover nothing). The rasterizer clips them in homogeneous
+// space; the ray caster intersects the world triangles.
 GltfScene clipScene() {
   GltfScene s;
   s.materials = {emissiveMaterial({0.9f, 0.2f, 0.2f}, 1.0f), emissiveMaterial({0.2f, 0.9f, 0.2f}, 1.0f),
@@ -223,9 +225,9 @@ GltfScene clipScene() {
     m.material = material;
     s.meshes.push_back(m);
   };
-  tri({-1.0f, -1.0f, -2.0f}, {1.0f, -1.0f, -2.0f}, {0.0f, 1.0f, 5.0f}, 0);  // vertex behind the eye
+  tri({-1.5f, 0.3f, -2.0f}, {1.5f, 0.3f, -2.0f}, {0.0f, 1.5f, 3.0f}, 0);    // vertex behind the eye
   tri({-1e6f, -0.5f, 1e6f}, {1e6f, -0.5f, 1e6f}, {0.0f, -0.5f, -1e6f}, 1);  // 2e6 across the eye plane
-  tri({3.0f, 0.3f, 0.0f}, {-0.5f, 0.2f, -3.0f}, {0.5f, 0.9f, -3.0f}, 2);    // a vertex at w = 0
+  tri({3.0f, 0.3f, 0.0f}, {-0.6f, 0.05f, -1.0f}, {0.2f, 0.3f, -1.0f}, 2);   // a vertex at w = 0
   tri({0.0f, 0.0f, 0.0f}, {-2.0f, 0.5f, -4.0f}, {-1.0f, 1.5f, -4.0f}, 3);   // a vertex at the eye
   GltfCamera c = lookDownZ(60.0 * 3.14159265358979323846 / 180.0);
   s.camera = c;
@@ -350,7 +352,7 @@ void appendLayerCases(std::vector<Case>& cases) {
   }
   cases.push_back(makeCase(
       "clip-near-w0", "clip",
-      "camera at the origin, znear 0.1: a triangle with a vertex 5 behind the eye, a floor 2e6 across the "
+      "camera at the origin, znear 0.1: a triangle with a vertex 3 behind the eye, a floor 2e6 across the "
       "eye plane, vertices at w = 0 and at the eye; 160x120 (quick 80x60), 4 spp; crossval",
       true, clipScene, [](const CaseContext& ctx, const std::string& name, const std::string& path) {
         const int w = ctx.quick ? 80 : 160, h = ctx.quick ? 60 : 120;
