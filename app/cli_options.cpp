@@ -25,10 +25,20 @@ CameraOverrides CameraOptions::overrides() const {
   if (!eye.empty()) o.eye = vec3(eye);
   if (!target.empty()) o.target = vec3(target);
   if (!up.empty()) o.up = vec3(up);
-  if (yfovOption && yfovOption->count()) o.yfovDegrees = yfov;
-  if (znearOption && znearOption->count()) o.znear = znear;
-  if (zfarOption && zfarOption->count()) o.zfar = zfar;
+  const auto given = [](const CLI::Option* option, bool detached) {
+    return option ? option->count() > 0 : detached;
+  };
+  if (given(yfovOption, yfovGiven)) o.yfovDegrees = yfov;
+  if (given(znearOption, znearGiven)) o.znear = znear;
+  if (given(zfarOption, zfarGiven)) o.zfar = zfar;
   return o;
+}
+
+void CameraOptions::detach() {
+  yfovGiven = yfovOption && yfovOption->count() > 0;
+  znearGiven = znearOption && znearOption->count() > 0;
+  zfarGiven = zfarOption && zfarOption->count() > 0;
+  yfovOption = znearOption = zfarOption = nullptr;
 }
 
 }  // namespace rastray

@@ -20,10 +20,16 @@ struct CameraOptions {
   CLI::Option* yfovOption = nullptr;
   CLI::Option* znearOption = nullptr;
   CLI::Option* zfarOption = nullptr;
+  // Whether each was given, once detach() has read it from the parser.
+  bool yfovGiven = false, znearGiven = false, zfarGiven = false;
   std::vector<int> size{kDefaultWidth, kDefaultHeight};
 
   void addTo(CLI::App& app);
   CameraOverrides overrides() const;
+  // Records which options were given and forgets the parser's options (the
+  // pointers above), so these settings stay valid after the CLI::App that
+  // parsed them is gone (settings built in process, app/stability_measure.h).
+  void detach();
   int width() const { return size[0]; }
   int height() const { return size[1]; }
 };

@@ -1,7 +1,266 @@
+// Far from the origin: a lit scene moved by 1e3 .. 1e7 in every
+// coordinate, the offset either baked into the float32 vertex data or kept
+// exact in the node translations, rendered by each renderer with the
+// mitigations on (defaults: --origin camera, --ray-offset error-bound) and
+// off (--origin world, --ray-offset float-ulps), and measured against the
+// same scene at the origin.
+//
+// Scene (local units; the offset adds to every coordinate): a 12 × 12
+// floor at y = 0; a 1.5 box and a sphere of radius 1.5 (24 × 12 facets,
+// flat normals: no NORMAL attribute) both floating 0.01 above the floor,
+// so their contact shadows are a 0.01 gap a ray offset must not jump; a
+// mirror (metallic 1, roughness 0) behind them; one directional light. The
+// camera looks down at them from (0, 4, 8).
+//
+// Per row:
+// - visibility agreement and genuine mismatches against the origin render
+//   of the same renderer (compare/classify.h, the origin scene's geometry);
+// - "px off %": pixels whose colour differs from the origin render by more
+//   than 0.1 in some RGBA channel (linear);
+// - acne and leaks against a double-precision shadow reference
+//   (checkShadows in app/stability_measure.h: exact hit points and brute-
+//   force double shadow rays in the file's frame).
+// Baked data are themselves rounded to float32 (spacing 2^-4 at 1e6, 1 at
+// 1e7): that geometry differs from the origin scene's before any renderer
+// sees it, hence the looser 1 % target for baked 1e6 and none at 1e7.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <unistd.h>
+
 #include "app/stability.h"
+#include "app/stability_measure.h"
 
 namespace rastray::stability {
 
-void appendFarCases(std::vector<Case>& cases) { (void)cases; }
+namespace {
+
+constexpr int kWidth = 480, kHeight = 320;
+constexpr int kQuickWidth = 240, kQuickHeight = 160;
+constexpr double kLift = 0.01;             // occluders float this far above the floor
+constexpr double kShadowTolerance = 1e-3;  // world units, about 1/16 pixel here (checkShadows)
+constexpr double kOffThreshold = 0.1;      // colour difference that makes a pixel "off"
+
+void addQuad(GltfMesh& m, const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2,
+             const glm::dvec3& p3, const glm::dvec3& offset, bool baked) {
+  const uint32_t base = uint32_t(m.positions.size());
+  for (const glm::dvec3& p : {p0, p1, p2, p3}) m.positions.push_back(glm::vec3(baked ? p + offset : p));
+  for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
+}
+
+GltfMesh meshAt(const glm::dvec3& offset, bool baked, int material) {
+  GltfMesh m;
+  m.material = material;
+  if (!baked) m.translation = offset;
+  return m;
+}
+
+GltfMesh box(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& offset, bool baked, int material) {
+  GltfMesh m = meshAt(offset, baked, material);
+  const auto c = [&](int x, int y, int z) {
+    return glm::dvec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z);
+  };
+  // Each face counter-clockwise seen from outside.
+  addQuad(m, c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1), offset, baked);  // +z
+  addQuad(m, c(1, 0, 0), c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), offset, baked);  // -z
+  addQuad(m, c(1, 0, 1), c(1, 0, 0), c(1, 1, 0), c(1, 1, 1), offset, baked);  // +x
+  addQuad(m, c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0), offset, baked);  // -x
+  addQuad(m, c(0, 1, 1), c(1, 1, 1), c(1, 1, 0), c(0, 1, 0), offset, baked);  // +y
+  addQuad(m, c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1), offset, baked);  // -y
+  return m;
+}
+
+GltfMesh sphere(const glm::dvec3& centre, double radius, const glm::dvec3& offset, bool baked, int material) {
+  GltfMesh m = meshAt(offset, baked, material);
+  constexpr int kSegments = 24, kRings = 12;
+  for (int i = 0; i <= kRings; ++i)
+    for (int j = 0; j <= kSegments; ++j) {
+      const double theta = M_PI * i / kRings, phi = 2.0 * M_PI * j / kSegments;
+      const glm::dvec3 p = centre + radius * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                                        -std::sin(theta) * std::sin(phi));
+      m.positions.push_back(glm::vec3(baked ? p + offset : p));
+    }
+  const auto at = [](int i, int j) { return uint32_t(i * (kSegments + 1) + j); };
+  for (int i = 0; i < kRings; ++i)
+    for (int j = 0; j < kSegments; ++j) {
+      // Counter-clockwise seen from outside; the pole rows have one triangle.
+      if (i > 0) m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i, j + 1)});
+      if (i + 1 < kRings) m.indices.insert(m.indices.end(), {at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
+    }
+  return m;
+}
+
+GltfScene farScene(double offsetValue, bool baked) {
+  const glm::dvec3 offset(offsetValue);
+  GltfScene s;
+  GltfMaterial floor, boxMaterial, sphereMaterial, mirror;
+  floor.baseColor = {0.8f, 0.8f, 0.8f, 1.0f};
+  boxMaterial.baseColor = {0.8f, 0.3f, 0.2f, 1.0f};
+  sphereMaterial.baseColor = {0.3f, 0.5f, 0.9f, 1.0f};
+  mirror.baseColor = {0.9f, 0.9f, 0.9f, 1.0f};
+  mirror.metallic = 1.0f;
+  mirror.roughness = 0.0f;
+  s.materials = {floor, boxMaterial, sphereMaterial, mirror};
+
+  GltfMesh floorMesh = meshAt(offset, baked, 0);
+  addQuad(floorMesh, {-6, 0, 6}, {6, 0, 6}, {6, 0, -6}, {-6, 0, -6}, offset, baked);
+  s.meshes.push_back(floorMesh);
+  s.meshes.push_back(box({-3.0, kLift, -0.75}, {-1.5, 1.5 + kLift, 0.75}, offset, baked, 1));
+  s.meshes.push_back(sphere({1.5, 1.5 + kLift, 0.0}, 1.5, offset, baked, 2));
+  GltfMesh mirrorMesh = meshAt(offset, baked, 3);
+  addQuad(mirrorMesh, {-4, 0.2, -3}, {4, 0.2, -3}, {4, 3.5, -3}, {-4, 3.5, -3}, offset, baked);
+  s.meshes.push_back(mirrorMesh);
+
+  GltfCamera camera;
+  camera.eye = offset + glm::dvec3(0.0, 4.0, 8.0);
+  camera.target = offset + glm::dvec3(0.0, 0.8, 0.0);
+  camera.yfov = 0.8;
+  camera.znear = 0.1;
+  camera.zfar = 100.0;
+  s.camera = camera;
+  GltfLight light;
+  light.direction = glm::normalize(glm::dvec3(-0.5, -1.0, -0.3));
+  light.intensity = 3.0f;
+  s.lights = {light};
+  return s;
+}
+
+// The origin scene, written for the run beside nothing the user owns: a
+// temporary file removed when the run ends.
+class OriginScene {
+ public:
+  OriginScene() {
+    static int counter = 0;
+    path_ = (std::filesystem::temp_directory_path() /
+             ("rastray-far-origin-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + ".gltf"))
+                .string();
+    farScene(0.0, false).write(path_);
+  }
+  ~OriginScene() {
+    std::error_code ec;
+    std::filesystem::remove(path_, ec);
+  }
+  OriginScene(const OriginScene&) = delete;
+  OriginScene& operator=(const OriginScene&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+struct Variant {
+  const char* renderer;
+  bool mitigations;
+};
+
+std::vector<std::string> variantArgs(const Variant& v, int w, int h) {
+  std::vector<std::string> a = {"--renderer",      v.renderer, "--size", std::to_string(w),
+                                std::to_string(h), "--spp",    "1"};
+  if (!v.mitigations) {
+    a.insert(a.end(), {"--origin", "world"});
+    if (std::string(v.renderer) != "raster") a.insert(a.end(), {"--ray-offset", "float-ulps"});
+  }
+  return a;
+}
+
+std::string variantName(const Variant& v) {
+  const bool rays = std::string(v.renderer) != "raster";
+  if (v.mitigations)
+    return std::string(v.renderer) + " on (origin camera" + (rays ? ", ray-offset error-bound)" : ")");
+  return std::string(v.renderer) + " off (origin world" + (rays ? ", ray-offset float-ulps)" : ")");
+}
+
+std::vector<Row> runFar(const CaseContext& ctx, const std::string& name, const std::string& path,
+                        double offset, bool baked) {
+  const int w = ctx.quick ? kQuickWidth : kWidth, h = ctx.quick ? kQuickHeight : kHeight;
+  const OriginScene origin;
+  std::vector<Row> rows;
+  for (const char* renderer : {"raster", "raytrace", "hybrid"}) {
+    const Rendered reference = renderVariant(ctx, origin.path(), variantArgs({renderer, true}, w, h), true,
+                                             std::string(renderer) + " at the origin");
+    const ShadowCheck referenceShadows = checkShadows(reference, kShadowTolerance);
+    for (const bool on : {true, false}) {
+      const Variant v{renderer, on};
+      const Rendered r = renderVariant(ctx, path, variantArgs(v, w, h), true, variantName(v));
+      const VisibilityReport vis = visibilityAgainst(r, reference);
+      const ShadowCheck shadows = checkShadows(r, kShadowTolerance);
+      Row row;
+      row.caseName = name;
+      row.variant = variantName(v);
+      row.agreement = agreementOf(vis);
+      row.genuine = genuineOf(vis);
+      row.nanInf = countNanInf(r.run.output);
+      row.acne = shadows.acne;
+      row.leaks = shadows.leaks;
+      row.metricName = "px off %";
+      row.metric = 100.0 * fractionOff(r.image(), reference.image(), kOffThreshold);
+      row.seconds = r.seconds();
+
+      // What this row asserts (mitigations off assert only "no NaN/Inf":
+      // they exist to show the failure).
+      std::string property = "no NaN/Inf";
+      bool pass = row.nanInf == 0;
+      const bool rayShadows = std::string(renderer) != "raster";
+      if (on && !baked) {
+        property += ", < 0.1 % px off";
+        pass = pass && row.metric < 0.1;
+      }
+      if (on && baked && offset <= 1e6) {
+        property += ", < 1 % px off";
+        pass = pass && row.metric < 1.0;
+      }
+      if (on && rayShadows && offset <= 1e6) {
+        property += ", 0 acne, 0 leaks";
+        pass = pass && row.acne == 0 && row.leaks == 0;
+      }
+      row.property = property;
+      row.pass = pass;
+
+      const std::string stem = std::string(renderer) + (on ? "-on" : "-off");
+      if (on)
+        addImage(row, writeRenderImage(ctx, name, std::string(renderer) + "-origin.png", reference.image(),
+                                       std::string(renderer) +
+                                           ", the same scene at the origin (reference); shadow "
+                                           "check there: acne " +
+                                           std::to_string(referenceShadows.acne) + ", leaks " +
+                                           std::to_string(referenceShadows.leaks)));
+      addImage(row, writeRenderImage(ctx, name, stem + ".png", r.image(), variantName(v)));
+      addImage(row, writeDifferenceImage(ctx, name, stem + "-diff.png", r.image(), reference.image(),
+                                         "colour difference from the origin render"));
+      addImage(row, writeMismatchImage(ctx, name, stem + "-mismatch.png", vis,
+                                       "visibility against the origin render, by mismatch class"));
+      addImage(row, writeValueImage(ctx, name, stem + "-shadows.png", r.image().width, r.image().height,
+                                    shadows.pixels, "0 fine, 1 acne, 2 leak",
+                                    "against the double-precision shadow reference (dark: not checked)"));
+      rows.push_back(row);
+    }
+  }
+  return rows;
+}
+
+}  // namespace
+
+void appendFarCases(std::vector<Case>& cases) {
+  for (const bool baked : {false, true})
+    for (int e = 3; e <= 7; ++e) {
+      const double offset = std::pow(10.0, e);
+      Case c;
+      c.name = std::string(baked ? "far-baked-" : "far-node-") + powerOfTen(offset);
+      c.group = "far";
+      c.parameters =
+          std::string("floor, box and sphere (r 1.5, flat) 0.01 above it, mirror, one directional light; +") +
+          powerOfTen(offset) + " on every coordinate " +
+          (baked ? "baked into float32 vertex data" : "in node translations (local data exact)") +
+          "; 480x320 (quick 240x160), 1 spp; each renderer, mitigations on and off, vs the origin scene";
+      c.quick = e == 6;
+      c.build = [offset, baked] { return farScene(offset, baked); };
+      const std::string name = c.name;
+      c.run = [name, offset, baked](const CaseContext& ctx, const std::string& path) {
+        return runFar(ctx, name, path, offset, baked);
+      };
+      cases.push_back(std::move(c));
+    }
+}
 
 }  // namespace rastray::stability

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "common/error.h"
+#include "common/sampling.h"
 #include "compare/classify.h"
 #include "compare/maps.h"
 
@@ -21,7 +22,8 @@ RenderSettings renderSettingsFrom(const std::vector<std::string>& args, bool all
   std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
   app.parse(reversed);
   settings.finish();
-  settings.cliOptions.clear();  // they point into `app`
+  settings.cliOptions.clear();  // they point into `app`, which is about to go
+  settings.camera.detach();
   return settings;
 }
 
@@ -96,6 +98,130 @@ CrossvalResult crossvalidateVariant(const CaseContext& ctx, const std::string& s
   const RenderSettings settings = renderSettingsFrom(args, /*allRenderers=*/true);
   const Scene scene = loadSceneForRender(scenePath, settings);
   return crossvalidate(scene, settings, ctx.progress);
+}
+
+namespace {
+
+// A stored triangle in double, in the render's frame (worldPositions minus
+// the render origin: both double, so this is exact to 2^-53 relative).
+struct DoubleTriangle {
+  glm::dvec3 a, b, c, n;  // n: unnormalised CCW normal
+  bool opaque = true;     // blocks light entirely (opaque, not transmissive)
+};
+
+bool diffuseOnly(const Scene& scene, uint32_t instance) {
+  const Material& m = scene.materialOf(instance);
+  return m.mirrorWeight() == 0.0f && m.transmission == 0.0f && m.baseColorTexture < 0 && !m.isEmissive() &&
+         m.alphaMode == AlphaMode::Opaque && !scene.instanceOf(instance).hasColors;
+}
+
+// Signed distance of q (in the triangle's plane) from the triangle's edges:
+// positive inside, the smallest over the three edges.
+double insideDistance(const DoubleTriangle& t, const glm::dvec3& q) {
+  const glm::dvec3 n = glm::normalize(t.n);
+  double d = INFINITY;
+  for (const auto& [p0, p1] : {std::pair{t.a, t.b}, {t.b, t.c}, {t.c, t.a}}) {
+    const glm::dvec3 e = p1 - p0;
+    d = std::min(d, glm::dot(glm::cross(e, q - p0), n) / glm::length(e));
+  }
+  return d;
+}
+
+}  // namespace
+
+ShadowCheck checkShadows(const Rendered& r, double tolerance) {
+  ShadowCheck out;
+  const Scene& scene = r.scene;
+  if (scene.lights.size() != 1) return out;
+  const Light& light = scene.lights[0];
+  if (light.type == LightType::Spot || (light.type == LightType::Point && light.range > 0.0f)) return out;
+  if (!r.run.output.hasSamples) throw std::logic_error("checkShadows: the render needs its samples");
+  out.acne = out.leaks = 0;
+
+  std::vector<DoubleTriangle> triangles(scene.triangles.size());
+  for (const Instance& inst : scene.instances)
+    for (uint32_t k = 0; k < inst.triangleCount; ++k) {
+      const glm::uvec3& v = scene.triangles[inst.firstTriangle + k];
+      DoubleTriangle& t = triangles[inst.firstTriangle + k];
+      t.a = scene.worldPositions[v.x] - scene.origin;
+      t.b = scene.worldPositions[v.y] - scene.origin;
+      t.c = scene.worldPositions[v.z] - scene.origin;
+      t.n = glm::cross(t.b - t.a, t.c - t.a);
+      const Material& m = scene.materials[inst.material];
+      t.opaque = m.alphaMode == AlphaMode::Opaque && m.transmission == 0.0f;
+    }
+
+  const Camera& camera = r.camera();
+  const DeepImage& deep = r.run.output.samples;
+  const std::vector<glm::dvec2> offsets = samplePositions(r.settings.spp);
+  out.pixels.assign(size_t(deep.width) * size_t(deep.height), NAN);
+  for (int y = 0; y < deep.height; ++y)
+    for (int x = 0; x < deep.width; ++x) {
+      const size_t pixel = size_t(y) * size_t(deep.width) + size_t(x);
+      uint32_t lastSample = UINT32_MAX;
+      for (uint64_t i = deep.offsets[pixel]; i < deep.offsets[pixel + 1]; ++i) {
+        const DeepSample& s = deep.samples[i];
+        if (s.sample == lastSample) continue;  // only the front layer
+        lastSample = s.sample;
+        if (s.instance == kNoId || s.sample >= offsets.size() || !diffuseOnly(scene, s.instance)) continue;
+        const uint32_t own = scene.instanceOf(s.instance).firstTriangle + s.triangle;
+        const DoubleTriangle& tri = triangles[own];
+        const Ray ray = camera.primaryRay(glm::dvec2(x, y) + offsets[s.sample]);
+        const double denom = glm::dot(ray.direction, tri.n);
+        if (denom == 0.0) continue;
+        const glm::dvec3 p = ray.origin + ray.direction * (glm::dot(tri.a - ray.origin, tri.n) / denom);
+        glm::dvec3 n = glm::normalize(tri.n);
+        if (glm::dot(n, ray.direction) > 0.0) n = -n;  // the side the camera sees
+
+        glm::dvec3 toLight = -light.direction;
+        double distance = INFINITY, irradiance = light.intensity;
+        if (light.type == LightType::Point) {
+          toLight = light.position - p;
+          distance = glm::length(toLight);
+          toLight /= distance;
+          irradiance = light.intensity / (distance * distance);
+        }
+        const double cosine = glm::dot(n, toLight);
+        const glm::vec4& albedo = scene.materialOf(s.instance).baseColorFactor;
+        const double expected = irradiance * std::max(cosine, 0.0) / M_PI *
+                                (double(albedo.r) * light.color.r + double(albedo.g) * light.color.g +
+                                 double(albedo.b) * light.color.b);
+        if (cosine < 0.1 || expected < 1e-3) {
+          ++out.ambiguous;
+          continue;
+        }
+        bool occluded = false, nearEdge = false;
+        for (size_t j = 0; j < triangles.size() && !occluded; ++j) {
+          if (j == own) continue;
+          const DoubleTriangle& o = triangles[j];
+          const double d = glm::dot(o.n, toLight);
+          if (d == 0.0) continue;  // parallel (or degenerate)
+          const double t = glm::dot(o.a - p, o.n) / d;
+          if (!(t > 1e-6 && t < distance)) continue;
+          const double inside = insideDistance(o, p + toLight * t);
+          if (inside > tolerance && o.opaque)
+            occluded = true;
+          else if (inside > -tolerance)
+            nearEdge = true;
+        }
+        if (!occluded && nearEdge) {
+          ++out.ambiguous;
+          continue;
+        }
+        const bool lit = double(s.color.r) + double(s.color.g) + double(s.color.b) > 0.5 * expected;
+        ++out.checked;
+        float& mark = out.pixels[pixel];
+        if (std::isnan(mark)) mark = 0.0f;
+        if (!occluded && !lit) {
+          ++out.acne;
+          mark = std::max(mark, 1.0f);
+        } else if (occluded && lit) {
+          ++out.leaks;
+          mark = 2.0f;
+        }
+      }
+    }
+  return out;
 }
 
 std::vector<float> pixelDifference(const FlatImage& a, const FlatImage& b) {

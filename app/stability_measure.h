@@ -75,6 +75,37 @@ int64_t genuineOf(const VisibilityReport& v);
 CrossvalResult crossvalidateVariant(const CaseContext& ctx, const std::string& scenePath,
                                     const std::vector<std::string>& args);
 
+// Acne and leaks against a double-precision shadow reference.
+//
+// For every sample's front layer on a diffuse surface (no mirror weight, no
+// transmission, no texture, no emission, opaque: where the shading is
+// exactly C/π · E · V · max(0, n·l), common/shading.h) the exact hit point
+// is rebuilt in double in the file's world frame (Scene::worldPositions):
+// the sample's camera ray, moved from the render's rebased frame by
+// Camera::worldOrigin, met with the plane of the triangle the render names.
+// A brute-force double shadow ray from there to the light is tested against
+// every other triangle of the scene (cases are small). Whether the renderer
+// lit the sample is read from its colour: lit when its RGB sum exceeds half
+// of the unshadowed C/π · E · (n·l) (n: the exact face normal, turned to
+// the viewer), so one render suffices and any renderer (shadow rays or
+// shadow maps) can be checked.
+//   acne: the reference says lit, the renderer darkened the sample;
+//   leak: the reference says shadowed, the renderer lit it.
+// Samples the reference cannot decide are skipped: n·l < 0.1 (the
+// terminator, where a renderer's float normal may legitimately flip), or a
+// shadow ray passing within `tolerance` (world units) of an occluder's
+// edge, or a triangle within 1e-6 along the ray (a coplanar neighbour).
+// Needs exactly one directional or point light (without range); otherwise
+// acne and leaks are -1 (not measured).
+struct ShadowCheck {
+  int64_t acne = -1, leaks = -1;
+  uint64_t checked = 0;    // samples decided and compared
+  uint64_t ambiguous = 0;  // skipped by the rules above
+  // Per pixel: 0 fine, 1 acne in some sample, 2 a leak, NaN not checked.
+  std::vector<float> pixels;
+};
+ShadowCheck checkShadows(const Rendered& r, double tolerance);
+
 // Colour difference of two same-size flat images: the largest |A − B| over
 // the RGBA channels of each pixel (linear, premultiplied, as rendered).
 // fractionOff: the share of pixels where it exceeds `threshold`.
