@@ -528,6 +528,17 @@ struct RayCaster::Impl {
 
   // --- secondary rays ------------------------------------------------------------
 
+  // Where a secondary or shadow ray leaving `from` along `direction`
+  // starts (raytrace/ray_offset.h): the one place both kinds get it.
+  glm::vec3 rayOrigin(const SurfacePoint& from, const glm::dvec3& direction) const {
+    const glm::dvec3 side = offsetSideNormal(from.geometricNormal, direction);
+    if (options.offset == RayOffsetMethod::FloatUlps)
+      return floatUlpsRayOrigin(glm::vec3(from.position), glm::vec3(side));
+    const glm::uvec3 t = scene.triangle(from.instance, from.triangle);
+    const FloatTriangle triangle = {scene.positions[t.x], scene.positions[t.y], scene.positions[t.z]};
+    return errorBoundRayOrigin(triangle, from.position, from.b1, from.b2, side);
+  }
+
   glm::vec3 radiance(const SurfacePoint& from, const glm::dvec3& direction, RayKind kind, int depth,
                      float throughput) const {
     if (depth > options.shading.maxDepth || !(throughput >= options.shading.minThroughput))
@@ -537,8 +548,7 @@ struct RayCaster::Impl {
     g.mode = GatherMode::Radiance;
     g.primary = false;
     const glm::dvec3 dir = glm::normalize(direction);
-    const glm::vec3 origin =
-        offsetRayOrigin(glm::vec3(from.position), glm::vec3(offsetSideNormal(from.geometricNormal, dir)));
+    const glm::vec3 origin = rayOrigin(from, dir);
     g.ray.origin = glm::dvec3(origin);
     g.ray.direction = dir;
     g.ray.tNear = 0.0;
@@ -576,8 +586,7 @@ struct RayCaster::Impl {
   glm::vec3 transmittance(const SurfacePoint& point, const glm::dvec3& toLight, double distance) const {
     count(RayKind::Shadow);
     const glm::dvec3 dir = glm::normalize(toLight);
-    const glm::vec3 origin =
-        offsetRayOrigin(glm::vec3(point.position), glm::vec3(offsetSideNormal(point.geometricNormal, dir)));
+    const glm::vec3 origin = rayOrigin(point, dir);
     HitGather g;
     g.mode = GatherMode::Shadow;
     g.primary = false;

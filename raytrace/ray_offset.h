@@ -1,27 +1,112 @@
-// Robust origins for secondary rays: no self-intersection, no magic epsilon.
+// Where secondary and shadow rays start: no self-intersection, no magic
+// epsilon. Two methods (RayOptions::offset, --ray-offset):
 //
-// Method: Wächter & Binder, "A Fast and Robust Method for Avoiding
-// Self-Intersection", Ray Tracing Gems (2019), chapter 6. The hit point is
-// rebuilt from the barycentrics (common/surface.h does that, in double;
-// it is rounded to float here, the precision Embree traces in), then moved
-// along the geometric normal by a fixed number of float ULPs per
-// component (int_scale · n), so the offset scales with the magnitude of
-// the coordinate: far from the origin it grows with the float spacing, and
-// the ray cannot re-hit the surface it leaves. Components within `origin`
-// of zero, where ULP steps become tiny (denormals), are offset by a fixed
-// float_scale · n instead. The constants are the published ones.
+// ErrorBound (default): from conservative error bounds of the actual
+// intersection, after pbrt-v4 (Triangle::InteractionFromIntersection,
+// OffsetRayOrigin), with bounds for OUR computation and for Embree's:
 //
-// Side: the caller passes the normal of the side the new ray leaves on
-// (+geometric normal for rays leaving through the front face, −geometric
-// normal otherwise), see offsetSideNormal().
+// 1. The hit point. SurfacePoint::position is b0·p0 + b1·p1 + b2·p2 in
+//    double over the stored float vertices p_i (common/surface.cpp), with
+//    b0 = 1 − b1 − b2 in double. Whatever the barycentrics' own error (the
+//    renderer's u, v; refinement; clamping), exact barycentrics summing to
+//    1 put the point exactly in the plane of the float triangle: their
+//    error only slides it within that plane. What leaves the plane is the
+//    arithmetic: per component k, the sum rounds each term at most three
+//    times, |error| ≤ γ3·Σ|b_i·p_ik|, and b0 is off by at most
+//    γ2·(1 + |b1| + |b2|), which moves the point by that times |p_0k|
+//    (γn = n·2⁻⁵³ / (1 − n·2⁻⁵³), double). Along the unit normal n that is
+//    dPos = Σ_k |n_k|·pError_k (pbrt's d = dot(|n|, pError)): about 1e-16
+//    of the vertex magnitudes, against pbrt's γ7 of float arithmetic.
+// 2. Embree's own error. Embree 3 in robust mode (RTC_SCENE_FLAG_ROBUST,
+//    raytrace/embree_scene.cpp) intersects with its Plücker test in float:
+//    it rounds the vertices relative to the ray origin o, v_i = fl(p_i − o),
+//    builds the normal from rounded edges and takes T = 2·dot(v_0, Ng),
+//    den = 2·dot(Ng, D), t = T·rcp(den), and accepts tnear = 0 ≤ t. In
+//    exact arithmetic T/2 = det(p_0 − o, p_1 − o, p_2 − o) = −h·|N| for an
+//    origin at height h above the plane on the front side (N = cross(p1 −
+//    p0, p2 − p0)): T < 0 < den for a ray leaving the front, so t < 0 and
+//    the surface is not hit again. Embree gets T's sign right whenever
+//    |T/2 − det| is below its error bound, which with u = 2⁻²⁴ is
+//      u·Σ_ik |w_ik·cof_ik| + 4u²·per|W| + 8u·Σ_k |w_0k|·C_k
+//    (w_i = p_i − o, cof their cofactors: the first-order change of a 3×3
+//    determinant when every entry moves by u of itself; C_k bounds the
+//    products in component k of the cross product Embree takes, over both
+//    edge pairs it may pick, covering the rounded edges, the cross and
+//    the dot product), plus an absolute 2⁻¹¹⁸·(1 + ΣR + ΣC) for results
+//    flushed to zero (traversal runs with FTZ/DAZ on). The bound measures
+//    the triangle RELATIVE TO THE ORIGIN: it scales with the triangle's
+//    size (and its shape: slivers need more), not with its distance from
+//    the world origin; an axis-aligned floor needs next to nothing, since
+//    every term then carries the origin's tiny height.
+// 3. The rounding to float. The target q = P + (dPos + dEmbree)·n is
+//    rounded to the nearest float in each component but one, m, the axis
+//    where a float step moves the point least (height excess plus the
+//    sideways move the correction needs, see compensatingAxis); m is
+//    rounded outward. Far from the origin a coarse component rounds by
+//    up to half its spacing (0.03 at 1e6); instead of pushing that outward
+//    along n (pbrt's NextFloatUp/Down, up to a full spacing times |n_k|)
+//    the height it costs is won back on axis m. Then the float origin is
+//    CHECKED against step 2 in double (leavesWithoutRehit) and axis m moves
+//    outward until it passes, so the guarantee does not rest on the
+//    estimate.
+//    Result: height above the float triangle's plane ≥ Embree's bound and
+//    ≥ 2⁻¹²⁰ (t stays a normal float), at most that plus one float
+//    spacing of o_m times |n_m|. E.g. a 20-unit floor: ~1e-5 units near
+//    the origin or at 1e6 alike (the RTG offset there: 16 units).
+//    Not covered: rays leaving within ~Embree's den error of the plane
+//    (|cos| ≲ 1e-5·shape), where den's sign is uncertain (the light
+//    weight there is that cos), and triangles whose products underflow
+//    float (edges ≲ 1e-12). Degenerate triangles (no plane) use FloatUlps.
+//
+// FloatUlps: Wächter & Binder, Ray Tracing Gems (2019) ch. 6: the hit
+// point rounded to float, moved by int(256·n_k) float ULPs per component
+// (1/65536·n_k within 1/32 of zero). The offset scales with the hit
+// point's own coordinates: 16 units along an axis normal at 1e6, so
+// shadow rays start beyond nearby occluders. Kept to show that failure.
+//
+// Side: the caller passes the unit normal of the side the new ray leaves
+// on (offsetSideNormal()).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <glm/glm.hpp>
 
 namespace rastray {
+
+// The stored float vertices of one triangle, in stored order (the order
+// Embree is given them).
+using FloatTriangle = std::array<glm::vec3, 3>;
+
+// ErrorBound: the origin of a ray leaving `position` (SurfacePoint::position,
+// rebuilt from barycentrics (b1, b2) over `triangle`) on the side of unit
+// normal `side`.
+glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
+                              const glm::dvec3& side);
+
+// Step 2 of the header for an origin `o` as Embree reads it (components
+// below FLT_MIN are zero under DAZ): the side volume G = s·dot(o − p0, N)
+// (s = ±1, the side `side` points to; G = height·|N|) and the bound B on
+// Embree's error in T/2, both in the units of a determinant, and |N|.
+struct EmbreeSideMargin {
+  double volume = 0.0;
+  double bound = 0.0;
+  double normalLength = 0.0;
+};
+EmbreeSideMargin embreeSideMargin(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side);
+
+// Whether Embree's T has the side's sign, certified: G > B and the height
+// G/|N| ≥ 2⁻¹²⁰ (so t = T/den does not flush to −0, which tnear 0 accepts).
+bool leavesWithoutRehit(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side);
+
+// Whether Embree's den = 2·dot(Ng, D) has the sign of side·D, certified:
+// true for every direction leaving more steeply than Embree's normal error
+// (header, "not covered"). With leavesWithoutRehit, a ray from o along
+// `direction` cannot hit the triangle again.
+bool denominatorCertified(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side,
+                          const glm::vec3& direction);
 
 struct RayOffsetConstants {
   static constexpr float kOrigin = 1.0f / 32.0f;         // below this |p|: fixed offset
@@ -42,9 +127,9 @@ inline float bitsFloat(int32_t i) {
 }
 }  // namespace detail
 
-// Ray Tracing Gems ch. 6 `offset_ray`: the origin of a ray leaving point p
-// on the side of unit normal n.
-inline glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n) {
+// FloatUlps: Ray Tracing Gems ch. 6 `offset_ray`, the origin of a ray
+// leaving point p on the side of unit normal n.
+inline glm::vec3 floatUlpsRayOrigin(const glm::vec3& p, const glm::vec3& n) {
   using C = RayOffsetConstants;
   glm::vec3 out;
   for (int k = 0; k < 3; ++k) {

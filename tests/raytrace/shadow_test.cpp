@@ -17,7 +17,7 @@ TEST(RayOffset, MovesByUlpsAlongTheNormalAndScalesWithMagnitude) {
   const glm::vec3 n(0.0f, 1.0f, 0.0f);
   for (float y : {1.0f, -1.0f, 1e5f, -1e6f}) {
     const glm::vec3 p(3.0f, y, -7.0f);
-    const glm::vec3 o = offsetRayOrigin(p, n);
+    const glm::vec3 o = floatUlpsRayOrigin(p, n);
     EXPECT_GT(o.y, p.y) << y;  // towards +normal, whatever the sign of p
     EXPECT_EQ(o.x, p.x);
     EXPECT_EQ(o.z, p.z);
@@ -27,7 +27,7 @@ TEST(RayOffset, MovesByUlpsAlongTheNormalAndScalesWithMagnitude) {
     EXPECT_GE(o.y - p.y, 128.0f * ulp) << y;
   }
   // Near zero: the fixed float_scale offset.
-  const glm::vec3 o = offsetRayOrigin(glm::vec3(0.0f), n);
+  const glm::vec3 o = floatUlpsRayOrigin(glm::vec3(0.0f), n);
   EXPECT_EQ(o.y, 1.0f / 65536.0f);
 }
 

@@ -1,0 +1,220 @@
+#include "raytrace/ray_offset.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <limits>
+
+namespace rastray {
+
+namespace {
+
+constexpr double kU = 0x1p-24;   // float unit roundoff: Embree's arithmetic
+constexpr double kUd = 0x1p-53;  // double unit roundoff: ours
+// Evaluating the bounds in double: inputs are floats (their differences
+// exact, or off by 2⁻⁵³), each product and sum rounds a few times more, so
+// 2⁻⁴⁵ of the magnitudes involved covers it (against Embree's 2⁻²⁴).
+constexpr double kEvalSlack = 0x1p-45;
+// Results flushed to zero under FTZ lose less than FLT_MIN = 2⁻¹²⁶ each;
+// a handful of them, scaled by at most the magnitudes R and C, stay below
+// this times (1 + ΣR + ΣC).
+constexpr double kUnderflow = 0x1p-118;
+// The least height: t = T·rcp(den) ≈ −height/cos must stay a normal
+// float, since FTZ would make it −0 and tnear 0 ≤ −0 holds.
+constexpr double kMinHeight = 0x1p-120;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double gammaD(int n) { return n * kUd / (1.0 - n * kUd); }
+
+// What Embree's traversal reads: DAZ turns inputs below FLT_MIN into 0.
+float daz(float x) { return std::fabs(x) < FLT_MIN ? 0.0f : x; }
+glm::dvec3 dazd(const glm::vec3& v) { return {daz(v.x), daz(v.y), daz(v.z)}; }
+
+using Vertices = std::array<glm::dvec3, 3>;
+
+Vertices verticesOf(const FloatTriangle& t) { return {dazd(t[0]), dazd(t[1]), dazd(t[2])}; }
+
+// The spacing of floats around x as traversal sees them (no denormals).
+double floatSpacing(double x) {
+  const float a = std::fabs(float(x));
+  if (!std::isfinite(a)) return kInf;
+  return std::max(double(std::nextafter(a, std::numeric_limits<float>::infinity())) - double(a),
+                  double(FLT_MIN));
+}
+
+// x rounded to a float on the side `direction` points to, never to a
+// denormal (which DAZ would read as 0): outward to ±FLT_MIN or to 0.
+float roundOutward(double x, double direction) {
+  float f = float(x);
+  if (direction > 0.0 && double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  if (direction < 0.0 && double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  if (f != 0.0f && std::fabs(f) < FLT_MIN) {
+    if (direction > 0.0)
+      f = f > 0.0f ? FLT_MIN : 0.0f;
+    else
+      f = f < 0.0f ? -FLT_MIN : 0.0f;
+  }
+  return f;
+}
+
+// Bounds on the magnitudes of the edges Embree computes, and on the
+// products in each component of the cross product it takes of them.
+struct EdgeBounds {
+  std::array<glm::dvec3, 3> edge;  // |e_j(v)| per component, e0 = v2 − v0, e1 = v0 − v1, e2 = v1 − v2
+  glm::dvec3 cross{0.0};           // C_k, over both pairs (e0, e1), (e1, e2) Embree may pick
+  glm::dvec3 reach{0.0};           // R_k = max_i |w_ik|
+};
+
+EdgeBounds edgeBounds(const Vertices& w) {
+  EdgeBounds b;
+  const int from[3] = {2, 0, 1}, to[3] = {0, 1, 2};  // e_j = w[from] − w[to]
+  for (int j = 0; j < 3; ++j) {
+    const glm::dvec3 &a = w[size_t(from[j])], &c = w[size_t(to[j])];
+    // Embree's vertices are w(1 + δ), |δ| ≤ u: their difference moves by
+    // at most u(|a| + |c|).
+    b.edge[size_t(j)] = glm::abs(a - c) + kU * (glm::abs(a) + glm::abs(c));
+  }
+  for (int k = 0; k < 3; ++k) {
+    const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+    auto products = [&](const glm::dvec3& a, const glm::dvec3& c) { return a[k1] * c[k2] + a[k2] * c[k1]; };
+    b.cross[k] = std::max(products(b.edge[0], b.edge[1]), products(b.edge[1], b.edge[2]));
+    b.reach[k] = std::max({std::abs(w[0][k]), std::abs(w[1][k]), std::abs(w[2][k])});
+  }
+  return b;
+}
+
+// The header's step 2 for origin o (as Embree reads it) and side sign s.
+EmbreeSideMargin margin(const Vertices& p, const glm::dvec3& o, double s) {
+  const Vertices w = {p[0] - o, p[1] - o, p[2] - o};
+  const Vertices cof = {glm::cross(w[1], w[2]), glm::cross(w[2], w[0]), glm::cross(w[0], w[1])};
+  const double det = glm::dot(w[0], cof[0]);  // = dot(p0 − o, N)
+  double first = 0.0;
+  for (size_t i = 0; i < 3; ++i) first += glm::dot(glm::abs(w[i]), glm::abs(cof[i]));
+  const glm::dvec3 a0 = glm::abs(w[0]), a1 = glm::abs(w[1]), a2 = glm::abs(w[2]);
+  const double permanent = a0.x * (a1.y * a2.z + a1.z * a2.y) + a0.y * (a1.x * a2.z + a1.z * a2.x) +
+                           a0.z * (a1.x * a2.y + a1.y * a2.x);
+  const EdgeBounds e = edgeBounds(w);
+  const double normalTerm = glm::dot(a0, e.cross);
+  EmbreeSideMargin m;
+  m.volume = -s * det;
+  m.bound = kU * first + 4.0 * kU * kU * permanent + 8.0 * kU * normalTerm +
+            kEvalSlack * (first + permanent + normalTerm) +
+            kUnderflow * (1.0 + e.reach.x + e.reach.y + e.reach.z + e.cross.x + e.cross.y + e.cross.z);
+  m.normalLength = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  return m;
+}
+
+bool certified(const EmbreeSideMargin& m) {
+  return m.volume > m.bound && m.volume >= kMinHeight * m.normalLength;
+}
+
+// The axis that corrects the height after rounding: moving it one float
+// step changes the height by spacing·|n_k| (the excess we may end with)
+// and winning back the others' rounding, up to half a spacing·|n_j| each,
+// moves the origin sideways by that over |n_k|. The cheapest sum wins: the
+// normal's axis when the coordinates are alike, a near-zero coordinate
+// with a good share of the normal far from the origin.
+int compensatingAxis(const glm::dvec3& q, const glm::dvec3& n) {
+  int best = 0;
+  double bestCost = kInf;
+  for (int k = 0; k < 3; ++k) {
+    if (n[k] == 0.0) continue;
+    double others = 0.0;
+    for (int j = 0; j < 3; ++j)
+      if (j != k) others += 0.5 * floatSpacing(q[j]) * std::abs(n[j]);
+    const double cost = floatSpacing(q[k]) * std::abs(n[k]) + others / std::abs(n[k]);
+    if (cost < bestCost) {
+      bestCost = cost;
+      best = k;
+    }
+  }
+  return best;
+}
+
+double sideSign(const Vertices& p, const glm::dvec3& side) {
+  return glm::dot(side, glm::cross(p[1] - p[0], p[2] - p[0])) >= 0.0 ? 1.0 : -1.0;
+}
+
+}  // namespace
+
+EmbreeSideMargin embreeSideMargin(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side) {
+  const Vertices p = verticesOf(triangle);
+  return margin(p, dazd(o), sideSign(p, side));
+}
+
+bool leavesWithoutRehit(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side) {
+  return certified(embreeSideMargin(triangle, o, side));
+}
+
+bool denominatorCertified(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side,
+                          const glm::vec3& direction) {
+  const Vertices p = verticesOf(triangle);
+  const glm::dvec3 origin = dazd(o), d = glm::abs(dazd(direction));
+  const Vertices w = {p[0] - origin, p[1] - origin, p[2] - origin};
+  const glm::dvec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
+  const EdgeBounds e = edgeBounds(w);
+  // den/2 against dot(N, D): the rounded dot product and cross product
+  // (γ3 and 4u of C_k, as for T) and the normal of Embree's rounded
+  // vertices against the true one (edges move by ≤ 2u·R_k each).
+  glm::dvec3 edgeMax(0.0);
+  for (const glm::dvec3& x : e.edge) edgeMax = glm::max(edgeMax, x);
+  double moved = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+    moved += d[k] * (e.reach[k1] * edgeMax[k2] + edgeMax[k1] * e.reach[k2]);
+  }
+  const double crossTerm = glm::dot(d, e.cross);
+  const double bound = 8.0 * kU * crossTerm + 5.0 * kU * moved + kEvalSlack * (crossTerm + moved) +
+                       kUnderflow * (1.0 + e.cross.x + e.cross.y + e.cross.z);
+  return sideSign(p, side) * glm::dot(n, dazd(direction)) > bound;
+}
+
+glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
+                              const glm::dvec3& side) {
+  const Vertices p = verticesOf(triangle);
+  const double normalLength = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  if (!(normalLength > 0.0) || !std::isfinite(normalLength))
+    return floatUlpsRayOrigin(glm::vec3(position), glm::vec3(side));  // no plane to leave
+  const double s = sideSign(p, side);
+
+  // 1. How far the double hit point may lie off the plane (header).
+  const double b0 = 1.0 - double(b1) - double(b2);
+  const double weightError = gammaD(2) * (1.0 + std::abs(double(b1)) + std::abs(double(b2)));
+  glm::dvec3 pError;
+  for (int k = 0; k < 3; ++k)
+    pError[k] = gammaD(3) * (std::abs(b0 * triangle[0][k]) + std::abs(double(b1) * triangle[1][k]) +
+                             std::abs(double(b2) * triangle[2][k])) +
+                weightError * std::abs(double(triangle[0][k]));
+  const double dPos = glm::dot(glm::abs(side), pError);
+
+  // 2. Embree's bound, estimated at the hit point, as a height.
+  const double dEmbree = std::max(margin(p, position, s).bound / normalLength, kMinHeight);
+
+  // 3. Round, then check the float origin and move axis m outward until
+  // it passes: the estimate above is only the starting point.
+  const glm::dvec3 q = position + (dPos + dEmbree) * side;
+  const int m = compensatingAxis(q, side);
+  glm::vec3 o;
+  for (int k = 0; k < 3; ++k) o[k] = k == m ? roundOutward(q[k], side[k]) : daz(float(q[k]));
+  double growth = 1.0;
+  for (int i = 0; i < 64; ++i) {
+    const EmbreeSideMargin c = margin(p, dazd(o), s);
+    if (certified(c)) break;
+    // The height still missing, along axis m (G grows by |N_m| per unit).
+    const double deficit = std::max(c.bound - c.volume, kMinHeight * c.normalLength - c.volume);
+    const double step = growth * (deficit / c.normalLength) * (1.0 + 0x1p-20) / std::abs(side[m]);
+    float next = roundOutward(double(o[m]) + std::copysign(step, side[m]), side[m]);
+    if (next == o[m])
+      next =
+          roundOutward(double(std::nextafter(o[m], side[m] > 0.0 ? std::numeric_limits<float>::infinity()
+                                                                 : -std::numeric_limits<float>::infinity())),
+                       side[m]);
+    o[m] = next;
+    // Slivers: the bound grows as the origin moves; overshoot after a few
+    // tries instead of creeping.
+    if (i >= 4) growth *= 2.0;
+  }
+  return o;
+}
+
+}  // namespace rastray
