@@ -229,12 +229,13 @@ std::vector<Row> runBubble(const CaseContext& ctx, const std::string& name, cons
 //   T_all + Σ_k F_k Π_{i<k} (1 − F_k)², F = ((n − 1)/(n + 1))² per surface
 //   (SPEC §5's model: 1.5, 1.33, 1.33, 1.5 against air), and at most 1.
 //   "On the axis" to float precision: a secondary ray starts off its hit
-//   along the facet's geometric normal (raytrace/ray_offset.h, ≈ 3e-5
-//   here), and the pole facets tilt by ≈ π/256, so each origin lands
-//   ≈ 4e-7 off the axis, where the smooth normal of a radius-0.5 sphere
-//   tilts by ≈ 1e-6 rad: the measured chain of 11 refractions stays within
-//   2e-6 rad, and the bound is 1e-5 rad (a real deviation, say a wrong
-//   normal or eta, is of the order of the facet tilt, 1e-2 rad).
+//   (raytrace/ray_offset.h), and a start ≈ 4e-7 off the axis (an offset of
+//   ≈ 3e-5 along a pole facet tilted by ≈ π/256) tilts the smooth normal of
+//   a radius-0.5 sphere by ≈ 1e-6 rad. Measured over the chain of 11
+//   refractions: 2e-6 rad with the ray offsets before commit 18ff2e4,
+//   1.5e-12 rad with the error-bound offsets since; the bound is 1e-5 rad (a
+//   real deviation, say a wrong normal or eta, is of the order of the facet
+//   tilt, 1e-2 rad).
 constexpr double kOuterIor = 1.5, kInnerIor = 1.33, kNestDistance = 3.0;
 constexpr int kNestW = 161, kNestH = 121, kNestQuickW = 81, kNestQuickH = 61;
 
