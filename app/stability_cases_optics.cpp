@@ -226,7 +226,7 @@ std::vector<Row> runBubble(const CaseContext& ctx, const std::string& name, cons
 //   meets all four surfaces at normal incidence: it and every ray it spawns
 //   stay on the axis (undeviated), and its pixel is at least the on-axis
 //   paths with at most one reflection, all of which the tracer follows:
-//   T_all + Σ_k F_k Π_{i<k} (1 − F_k)², F = ((n − 1)/(n + 1))² per surface
+//   T_all + Σ_k F_k Π_{i<k} (1 − F_i)², F = ((n − 1)/(n + 1))² per surface
 //   (SPEC §5's model: 1.5, 1.33, 1.33, 1.5 against air), and at most 1.
 //   "On the axis" to float precision: a secondary ray starts off its hit
 //   (raytrace/ray_offset.h), and a start ≈ 4e-7 off the axis (an offset of
