@@ -97,6 +97,7 @@ std::string formatTable(const std::vector<CaseResult>& results) {
       if (k) line += "  ";
       line += left(k) ? (k + 1 == cells.size() ? cells[k] : cells[k] + pad) : pad + cells[k];
     }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
     out += line + "\n";
   };
   emit(header);
