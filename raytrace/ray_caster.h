@@ -39,10 +39,19 @@
 //   directional lights); occlusion filters accept opaque hits (blocked)
 //   and collect the rest, whose Shader::shadowTransmittance values multiply
 //   (BLEND 1 − α, refractive transmission × C; SPEC §5).
-// - Secondary rays start at offsetRayOrigin() (raytrace/ray_offset.h, Ray
-//   Tracing Gems ch. 6) on the side they leave, tnear 0, and are shaded at
-//   the depth the Shader gives them; --max-depth and the throughput
-//   cut-off come from ShadingOptions.
+// - Secondary and shadow rays (radiance(), transmittance(): the only
+//   secondary-ray origins, hybrid's included) start on the side they leave,
+//   tnear 0, at the origin RayOptions::offset picks (raytrace/ray_offset.h):
+//   ErrorBound (default) a float origin above the hit's float triangle by
+//   at least Embree's error bound for that origin (checked, not estimated),
+//   which scales with the triangle's size and shape, plus at most one float
+//   spacing of one coordinate (0.0625 at 1e6) — so the ray cannot hit the
+//   surface it leaves again, for every direction leaving the plane by more
+//   than ~1e-5 (times the triangle's aspect ratio); FloatUlps the Ray
+//   Tracing Gems ch. 6 offset of 256 ULPs of the hit point's own
+//   coordinates (16 units at 1e6). They are shaded at the depth the
+//   Shader gives them; --max-depth and the throughput cut-off come from
+//   ShadingOptions.
 // - Deep samples (keepSamples): for every sample, every surface its primary
 //   ray composited, front to back, each with its OWN unattenuated
 //   premultiplied colour (what Shader::shade returns for it), ending with
@@ -72,7 +81,7 @@ namespace rastray {
 
 // Where secondary and shadow rays start (raytrace/ray_offset.h).
 enum class RayOffsetMethod {
-  ErrorBound,  // conservative bound on the hit point's rounding error, from its triangle's vertices (pbrt-v4)
+  ErrorBound,  // above the hit's triangle by Embree's error bound for the origin traced (after pbrt-v4)
   FloatUlps,   // a fixed count of float ULPs of the hit point's own coordinates (Ray Tracing Gems ch. 6)
 };
 const char* toString(RayOffsetMethod method);

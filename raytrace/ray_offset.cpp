@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cstring>
 #include <limits>
 
 namespace rastray {
@@ -34,12 +35,16 @@ using Vertices = std::array<glm::dvec3, 3>;
 
 Vertices verticesOf(const FloatTriangle& t) { return {dazd(t[0]), dazd(t[1]), dazd(t[2])}; }
 
-// The spacing of floats around x as traversal sees them (no denormals).
+// The spacing of floats around x as traversal sees them (no denormals):
+// 2^(exponent − 23), read from the bits (this runs for every ray).
 double floatSpacing(double x) {
-  const float a = std::fabs(float(x));
-  if (!std::isfinite(a)) return kInf;
-  return std::max(double(std::nextafter(a, std::numeric_limits<float>::infinity())) - double(a),
-                  double(FLT_MIN));
+  const float f = float(x);
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  const int exponent = int((bits >> 23) & 0xffu);
+  if (exponent == 0xff) return kInf;
+  if (exponent == 0) return double(FLT_MIN);
+  return std::ldexp(1.0, exponent - 127 - 23);
 }
 
 // x rounded to a float on the side `direction` points to, never to a
@@ -67,24 +72,22 @@ struct EdgeBounds {
 
 EdgeBounds edgeBounds(const Vertices& w) {
   EdgeBounds b;
-  const int from[3] = {2, 0, 1}, to[3] = {0, 1, 2};  // e_j = w[from] − w[to]
-  for (int j = 0; j < 3; ++j) {
-    const glm::dvec3 &a = w[size_t(from[j])], &c = w[size_t(to[j])];
-    // Embree's vertices are w(1 + δ), |δ| ≤ u: their difference moves by
-    // at most u(|a| + |c|).
-    b.edge[size_t(j)] = glm::abs(a - c) + kU * (glm::abs(a) + glm::abs(c));
-  }
-  for (int k = 0; k < 3; ++k) {
-    const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-    auto products = [&](const glm::dvec3& a, const glm::dvec3& c) { return a[k1] * c[k2] + a[k2] * c[k1]; };
-    b.cross[k] = std::max(products(b.edge[0], b.edge[1]), products(b.edge[1], b.edge[2]));
-    b.reach[k] = std::max({std::abs(w[0][k]), std::abs(w[1][k]), std::abs(w[2][k])});
-  }
+  const glm::dvec3 a0 = glm::abs(w[0]), a1 = glm::abs(w[1]), a2 = glm::abs(w[2]);
+  // Embree's vertices are w(1 + δ), |δ| ≤ u: the difference of two moves
+  // by at most u(|a| + |c|).
+  b.edge[0] = glm::abs(w[2] - w[0]) + kU * (a2 + a0);
+  b.edge[1] = glm::abs(w[0] - w[1]) + kU * (a0 + a1);
+  b.edge[2] = glm::abs(w[1] - w[2]) + kU * (a1 + a2);
+  const glm::dvec3 &e0 = b.edge[0], &e1 = b.edge[1], &e2 = b.edge[2];
+  const glm::dvec3 c01(e0.y * e1.z + e0.z * e1.y, e0.z * e1.x + e0.x * e1.z, e0.x * e1.y + e0.y * e1.x);
+  const glm::dvec3 c12(e1.y * e2.z + e1.z * e2.y, e1.z * e2.x + e1.x * e2.z, e1.x * e2.y + e1.y * e2.x);
+  b.cross = glm::max(c01, c12);
+  b.reach = glm::max(glm::max(a0, a1), a2);
   return b;
 }
 
 // The header's step 2 for origin o (as Embree reads it) and side sign s.
-EmbreeSideMargin margin(const Vertices& p, const glm::dvec3& o, double s) {
+EmbreeSideMargin margin(const Vertices& p, const glm::dvec3& o, double s, double normalLength) {
   const Vertices w = {p[0] - o, p[1] - o, p[2] - o};
   const Vertices cof = {glm::cross(w[1], w[2]), glm::cross(w[2], w[0]), glm::cross(w[0], w[1])};
   const double det = glm::dot(w[0], cof[0]);  // = dot(p0 − o, N)
@@ -100,7 +103,7 @@ EmbreeSideMargin margin(const Vertices& p, const glm::dvec3& o, double s) {
   m.bound = kU * first + 4.0 * kU * kU * permanent + 8.0 * kU * normalTerm +
             kEvalSlack * (first + permanent + normalTerm) +
             kUnderflow * (1.0 + e.reach.x + e.reach.y + e.reach.z + e.cross.x + e.cross.y + e.cross.z);
-  m.normalLength = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  m.normalLength = normalLength;
   return m;
 }
 
@@ -115,14 +118,14 @@ bool certified(const EmbreeSideMargin& m) {
 // normal's axis when the coordinates are alike, a near-zero coordinate
 // with a good share of the normal far from the origin.
 int compensatingAxis(const glm::dvec3& q, const glm::dvec3& n) {
+  const glm::dvec3 spacing(floatSpacing(q.x), floatSpacing(q.y), floatSpacing(q.z));
+  const glm::dvec3 halfStep = 0.5 * spacing * glm::abs(n);
+  const double allHalfSteps = halfStep.x + halfStep.y + halfStep.z;
   int best = 0;
   double bestCost = kInf;
   for (int k = 0; k < 3; ++k) {
     if (n[k] == 0.0) continue;
-    double others = 0.0;
-    for (int j = 0; j < 3; ++j)
-      if (j != k) others += 0.5 * floatSpacing(q[j]) * std::abs(n[j]);
-    const double cost = floatSpacing(q[k]) * std::abs(n[k]) + others / std::abs(n[k]);
+    const double cost = 2.0 * halfStep[k] + (allHalfSteps - halfStep[k]) / std::abs(n[k]);
     if (cost < bestCost) {
       bestCost = cost;
       best = k;
@@ -139,7 +142,7 @@ double sideSign(const Vertices& p, const glm::dvec3& side) {
 
 EmbreeSideMargin embreeSideMargin(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side) {
   const Vertices p = verticesOf(triangle);
-  return margin(p, dazd(o), sideSign(p, side));
+  return margin(p, dazd(o), sideSign(p, side), glm::length(glm::cross(p[1] - p[0], p[2] - p[0])));
 }
 
 bool leavesWithoutRehit(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side) {
@@ -188,17 +191,25 @@ glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& p
   const double dPos = glm::dot(glm::abs(side), pError);
 
   // 2. Embree's bound, estimated at the hit point, as a height.
-  const double dEmbree = std::max(margin(p, position, s).bound / normalLength, kMinHeight);
+  const double dEmbree = std::max(margin(p, position, s, normalLength).bound / normalLength, kMinHeight);
 
   // 3. Round, then check the float origin and move axis m outward until
   // it passes: the estimate above is only the starting point.
   const glm::dvec3 q = position + (dPos + dEmbree) * side;
   const int m = compensatingAxis(q, side);
+  // The others to nearest; whatever height their rounding gained or lost
+  // (Σ (o_k − q_k)·n_k), axis m gives back or takes, then rounds outward.
   glm::vec3 o;
-  for (int k = 0; k < 3; ++k) o[k] = k == m ? roundOutward(q[k], side[k]) : daz(float(q[k]));
+  double qm = q[m];
+  for (int k = 0; k < 3; ++k) {
+    if (k == m) continue;
+    o[k] = daz(float(q[k]));
+    qm -= (double(o[k]) - q[k]) * side[k] / side[m];
+  }
+  o[m] = roundOutward(qm, side[m]);
   double growth = 1.0;
   for (int i = 0; i < 64; ++i) {
-    const EmbreeSideMargin c = margin(p, dazd(o), s);
+    const EmbreeSideMargin c = margin(p, dazd(o), s, normalLength);
     if (certified(c)) break;
     // The height still missing, along axis m (G grows by |N_m| per unit).
     const double deficit = std::max(c.bound - c.volume, kMinHeight * c.normalLength - c.volume);
