@@ -63,9 +63,17 @@ std::vector<double> lookAtNodeMatrix(const glm::dvec3& eye, const glm::dvec3& fo
   return {x.x, x.y, x.z, 0.0, y.x, y.y, y.z, 0.0, z.x, z.y, z.z, 0.0, eye.x, eye.y, eye.z, 1.0};
 }
 
-std::string GltfScene::toJson() const {
+namespace {
+
+// The document without its buffer; the buffer's bytes go to `bytes` (a
+// data URI for .gltf, the BIN chunk for .glb).
+nlohmann::json buildDocument(const GltfScene& scene, std::vector<unsigned char>& bytes) {
   using nlohmann::json;
-  std::vector<unsigned char> bytes;
+  const auto& meshes = scene.meshes;
+  const auto& materials = scene.materials;
+  const auto& textures = scene.textures;
+  const auto& camera = scene.camera;
+  const auto& lights = scene.lights;
   json accessors = json::array(), views = json::array(), meshesJson = json::array(), nodes = json::array();
   json sceneNodes = json::array();
   // One float accessor over `count` elements of `components` floats.
@@ -136,15 +144,12 @@ std::string GltfScene::toJson() const {
     }
     materialsJson.push_back(j);
   }
-  json doc = {
-      {"asset", {{"version", "2.0"}, {"generator", "rastray tests/app/gltf_writer"}}},
-      {"scene", 0},
-      {"materials", materialsJson},
-      {"meshes", meshesJson},
-      {"accessors", accessors},
-      {"bufferViews", views},
-      {"buffers",
-       {{{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}}}}};
+  json doc = {{"asset", {{"version", "2.0"}, {"generator", "rastray tests/app/gltf_writer"}}},
+              {"scene", 0},
+              {"materials", materialsJson},
+              {"meshes", meshesJson},
+              {"accessors", accessors},
+              {"bufferViews", views}};
   if (!textures.empty()) {
     json images = json::array(), samplers = json::array(), texturesJson = json::array();
     for (const GltfTexture& t : textures) {
@@ -189,12 +194,54 @@ std::string GltfScene::toJson() const {
   if (!used.empty()) doc["extensionsUsed"] = used;
   doc["nodes"] = nodes;
   doc["scenes"] = {{{"nodes", sceneNodes}}};
+  return doc;
+}
+
+void putU32(std::ostream& out, uint32_t v) {
+  const unsigned char b[4] = {static_cast<unsigned char>(v), static_cast<unsigned char>(v >> 8),
+                              static_cast<unsigned char>(v >> 16), static_cast<unsigned char>(v >> 24)};
+  out.write(reinterpret_cast<const char*>(b), 4);
+}
+
+}  // namespace
+
+std::string GltfScene::toJson() const {
+  std::vector<unsigned char> bytes;
+  nlohmann::json doc = buildDocument(*this, bytes);
+  doc["buffers"] = {
+      {{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + base64(bytes)}}};
   return doc.dump(1);
 }
 
 void GltfScene::write(const std::string& path) const {
   std::ofstream out(path, std::ios::binary);
   out << toJson();
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+void GltfScene::writeGlb(const std::string& path) const {
+  std::vector<unsigned char> bytes;
+  nlohmann::json doc = buildDocument(*this, bytes);
+  doc["buffers"] = {{{"byteLength", bytes.size()}}};  // no uri: the BIN chunk
+  std::string text = doc.dump();
+  // Chunks end on 4-byte boundaries: JSON padded with spaces, BIN with zeros.
+  text.append((4 - text.size() % 4) % 4, ' ');
+  const size_t binPadded = (bytes.size() + 3) / 4 * 4;
+  const uint64_t total = 12 + 8 + uint64_t(text.size()) + 8 + uint64_t(binPadded);
+  if (total > 0xFFFFFFFFull)
+    throw std::runtime_error("gltf_writer: " + path + ": a .glb holds at most 4 GiB");
+  std::ofstream out(path, std::ios::binary);
+  putU32(out, 0x46546C67);  // "glTF"
+  putU32(out, 2);
+  putU32(out, uint32_t(total));
+  putU32(out, uint32_t(text.size()));
+  putU32(out, 0x4E4F534A);  // "JSON"
+  out.write(text.data(), std::streamsize(text.size()));
+  putU32(out, uint32_t(binPadded));
+  putU32(out, 0x004E4942);  // "BIN\0"
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  const char zeros[3] = {0, 0, 0};
+  out.write(zeros, std::streamsize(binPadded - bytes.size()));
   if (!out) throw std::runtime_error("cannot write " + path);
 }
 

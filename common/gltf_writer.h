@@ -1,11 +1,11 @@
 // Writes small glTF 2.0 files from code: the generated scenes of tests
-// (regression cases, random scenes) and of `rastray stability`. Positions,
-// optional normals and texcoords, and uint32 indices in one base64 data-URI
-// buffer; metallic-roughness materials with an optional base colour texture
+// (regression cases, random scenes), of `rastray stability` and of the
+// crossover study. Positions, optional normals and texcoords, and uint32
+// indices in one buffer (a base64 data URI in .gltf, the BIN chunk in
+// .glb); metallic-roughness materials with an optional base colour texture
 // (8-bit RGB, embedded as a data-URI PNG), an emissive factor and
-// KHR_materials_transmission/ior;
-// one optional perspective or orthographic camera (placed by
-// eye/target/up) and KHR_lights_punctual lights.
+// KHR_materials_transmission/ior; one optional perspective or orthographic
+// camera (placed by eye/target/up) and KHR_lights_punctual lights.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -72,6 +72,11 @@ struct GltfScene {
 
   std::string toJson() const;
   void write(const std::string& path) const;  // throws std::runtime_error when it cannot
+  // The same scene as binary glTF: the JSON chunk, then buffer 0 as the BIN
+  // chunk (no base64: large generated meshes write and load fast). Textures
+  // stay data-URI PNGs. Throws std::runtime_error when it cannot write or the
+  // file would pass the format's 4 GiB limit.
+  void writeGlb(const std::string& path) const;
 };
 
 // A node transform that maps the node's −Z to `forward` (camera, light

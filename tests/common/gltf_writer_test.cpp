@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/gltf_writer.h"
 #include "common/scene.h"
@@ -101,6 +102,59 @@ TEST(GltfWriter, EmissiveFactorReadsBackExactly) {
   ASSERT_EQ(s.materials.size(), 2u);
   EXPECT_EQ(s.materials[0].emissive, glm::vec3(0.1f, 1.0f, 1e-6f));
   EXPECT_EQ(s.materials[1].emissive, glm::vec3(0.0f));
+}
+
+// .glb: the same scene loads the same as its .gltf, the container is laid
+// out as glTF 2.0 says (12-byte header, JSON then BIN chunk, each padded to 4
+// bytes), and buffer 0 has no uri.
+TEST(GltfWriter, GlbLoadsLikeTheGltf) {
+  GltfScene written = texturedQuad();
+  // Three triangles' worth of indices plus odd-sized texcoords: the BIN
+  // chunk needs padding.
+  written.meshes[0].positions.push_back({0.5f, 0.25f, 0.125f});
+  written.meshes[0].normals.push_back({0, 0, 1});
+  written.meshes[0].texcoords.push_back({0.5f, 0.5f});
+  written.meshes[0].indices.insert(written.meshes[0].indices.end(), {0, 1, 4});
+  GltfLight light;
+  written.lights.push_back(light);
+  const std::string gltfPath = tempPath("same.gltf"), glbPath = tempPath("same.glb");
+  written.write(gltfPath);
+  written.writeGlb(glbPath);
+  const Scene a = loadScene(gltfPath), b = loadScene(glbPath);
+
+  std::FILE* f = std::fopen(glbPath.c_str(), "rb");
+  ASSERT_NE(f, nullptr);
+  std::vector<unsigned char> bytes;
+  for (int c; (c = std::fgetc(f)) != EOF;) bytes.push_back(static_cast<unsigned char>(c));
+  std::fclose(f);
+  std::remove(gltfPath.c_str());
+  std::remove(glbPath.c_str());
+  auto u32 = [&](size_t at) {
+    return uint32_t(bytes[at]) | uint32_t(bytes[at + 1]) << 8 | uint32_t(bytes[at + 2]) << 16 |
+           uint32_t(bytes[at + 3]) << 24;
+  };
+  ASSERT_GE(bytes.size(), 28u);
+  EXPECT_EQ(u32(0), 0x46546C67u);
+  EXPECT_EQ(u32(4), 2u);
+  EXPECT_EQ(u32(8), bytes.size());
+  const uint32_t jsonLength = u32(12);
+  EXPECT_EQ(u32(16), 0x4E4F534Au);
+  EXPECT_EQ(jsonLength % 4, 0u);
+  const std::string json(bytes.begin() + 20, bytes.begin() + 20 + jsonLength);
+  EXPECT_EQ(json.find("\"uri\":\"data:application"), std::string::npos);
+  const size_t bin = 20 + jsonLength;
+  EXPECT_EQ(u32(bin + 4), 0x004E4942u);
+  EXPECT_EQ(u32(bin) % 4, 0u);
+  EXPECT_EQ(bin + 8 + u32(bin), bytes.size());
+
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.normals, b.normals);
+  EXPECT_EQ(a.texcoords, b.texcoords);
+  EXPECT_EQ(a.triangles, b.triangles);
+  ASSERT_EQ(b.triangles.size(), 3u);
+  EXPECT_EQ(a.lights.size(), b.lights.size());
+  ASSERT_EQ(b.images.size(), 1u);
+  EXPECT_EQ(a.images[0].rgba8, b.images[0].rgba8);
 }
 
 TEST(GltfWriter, RefusesWhatGltfCannotSay) {
