@@ -16,5 +16,6 @@ CommandRunner addCrossvalCommand(CLI::App& app);
 CommandRunner addExplainCommand(CLI::App& app);
 CommandRunner addCompareCommand(CLI::App& app);
 CommandRunner addStabilityCommand(CLI::App& app);
+CommandRunner addSweepCommand(CLI::App& app);
 
 }  // namespace rastray

@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   commands.push_back(addCrossvalCommand(app));
   commands.push_back(addExplainCommand(app));
   commands.push_back(addStabilityCommand(app));
+  commands.push_back(addSweepCommand(app));
 #endif
   commands.push_back(addCompareCommand(app));
 
