@@ -9,9 +9,11 @@
 
 #include <tbb/global_control.h>
 
+#include "app/crossval.h"
 #include "app/stability_measure.h"
 #include "common/error.h"
 #include "compare/color_metrics.h"
+#include "compare/visibility.h"
 
 namespace rastray::sweep {
 
@@ -373,7 +375,8 @@ TimeStats timeStats(std::vector<double> seconds) {
   return t;
 }
 
-CellErrors measureErrors(const FlatImage& color, const FlatImage& centre, const Reference& reference) {
+CellErrors measureErrors(const FlatImage& color, const FlatImage& centre, const Reference& reference,
+                         const ClassifierSettings* classifier) {
   RASTRAY_CHECK(color.width == reference.color.width && color.height == reference.color.height &&
                     centre.width == reference.centre.width && centre.height == reference.centre.height,
                 "measureErrors: sizes differ");
@@ -403,7 +406,16 @@ CellErrors measureErrors(const FlatImage& color, const FlatImage& centre, const 
     e.depthMaxRel = std::max(e.depthMaxRel, rel);
     ++e.depthPixels;
   }
-  e.visibility = double(differ) / double(e.pixels);
+  uint64_t sharedEdge = 0;
+  if (classifier && differ) {
+    const VisibilityReport v = compareVisibility(centre, reference.centre, 1, *classifier,
+                                                 FrameNames{"cell", reference.description});
+    RASTRAY_CHECK(v.samples.mismatching() == differ,
+                  "measureErrors: the classification counted another total");
+    sharedEdge = v.samples.count(MismatchClass::SharedEdgeTie);
+  }
+  e.visibility = double(differ - sharedEdge) / double(e.pixels);
+  e.visibilitySharedEdge = double(sharedEdge) / double(e.pixels);
   if (e.depthPixels) {
     e.depthMeanAbs = sumAbs / double(e.depthPixels);
     e.depthMeanRel = sumRel / double(e.depthPixels);
@@ -492,7 +504,16 @@ CellResult measureCell(const Cell& cell, int repeat, ReferenceSource& references
   result.time = timeStats(time);
   const FlatImage centre =
       cell.settings.spp == 1 ? image : renderScene(scene, atCentre(cell.settings)).output.image;
-  result.errors = measureErrors(image, centre, reference);
+  // Differences at the centres are classified in the cell's frame, against
+  // the depth buffer it rasterized with (the ray caster: float-reversed).
+  const Camera camera = makeCamera(scene, cell.settings.camera.overrides(), width, height);
+  ClassifierSettings classifier;
+  if (cell.settings.renderer != RendererKind::Raytrace)
+    classifier.depthFormat = storedDepthFormat(cell.settings.raster.depthFormat);
+  classifier.planes = {true, camera.projection, camera.znear, camera.zfar};
+  classifier.scene = &scene;
+  classifier.camera = &camera;
+  result.errors = measureErrors(image, centre, reference, &classifier);
   return result;
 }
 

@@ -22,6 +22,7 @@
 
 #include "app/render_setup.h"
 #include "common/image.h"
+#include "compare/classify.h"
 
 namespace rastray::sweep {
 
@@ -100,7 +101,11 @@ TimeStats timeStats(std::vector<double> seconds);
 struct CellErrors {
   double rms = 0, max = 0;  // colour, linear premultiplied RGBA (ImageBufAlgo compare)
   double perceptual = 0;    // share of pixels Yee's test sees as different
-  double visibility = 0;    // share of pixels whose centre (instance, triangle) differs
+  // Share of pixels whose centre (instance, triangle) differs, not counting
+  // shared-edge ties (the centre on the edge two triangles of one surface
+  // share: either is right, SPEC §3), which are counted apart.
+  double visibility = 0;
+  double visibilitySharedEdge = 0;
   double depthMeanAbs = 0, depthMaxAbs = 0, depthMeanRel = 0, depthMaxRel = 0;
   uint64_t pixels = 0;       // width × height
   uint64_t depthPixels = 0;  // pixels both hit with the same IDs (the depth error's support)
@@ -119,11 +124,15 @@ struct Reference {
 // color: the cell's resolved image; centre: the cell's Z and IDs at the
 // pixel centres (its own image at 1 spp, else a 1-spp render with the same
 // settings: visibility at a point does not depend on the sample count).
-// Both the reference's size (the caller checks). RMS and max come from
+// Both the reference's size (the caller checks). With `classifier` (the
+// cell's scene and camera, compare/classify.h), each centre that differs is
+// classified and shared-edge ties are counted apart; without, every
+// difference counts. RMS and max come from
 // compare/color_metrics.h over RGBA; the perceptual error is Yee's count
 // over the pixel count (FLIP is not packaged for Debian). Depth: |z − z_ref|
 // and |z − z_ref| / z_ref over pixels where both hit the same triangle.
-CellErrors measureErrors(const FlatImage& color, const FlatImage& centre, const Reference& reference);
+CellErrors measureErrors(const FlatImage& color, const FlatImage& centre, const Reference& reference,
+                         const ClassifierSettings* classifier = nullptr);
 
 struct CellResult {
   size_t index = 0;

@@ -140,8 +140,7 @@ void writeSweepReport(const std::string& dir, const SweepMeta& meta, const std::
   std::map<std::string, std::string> svgs;
   for (const SweepPlot& p : plots) {
     const PlotRender rendered = renderPlot(p.plot);
-    writeTextFile((std::filesystem::path(dir) / "plots" / p.file).string(),
-                  "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n" + rendered.svg);
+    writeTextFile((std::filesystem::path(dir) / "plots" / p.file).string(), rendered.svg);
     body += "<figure>" + rendered.svg + "<figcaption><a href=\"plots/" + escapeHtml(p.file) + "\">" +
             escapeHtml(p.file) + "</a></figcaption></figure>\n";
   }
@@ -165,7 +164,8 @@ void writeSweepReport(const std::string& dir, const SweepMeta& meta, const std::
   for (const VaryAxis& v : meta.spec.vary) body += "<th>" + escapeHtml(v.name) + "</th>";
   body +=
       "<th>size</th><th>time ms<br>median</th><th>min–max ms</th><th>build ms</th><th>load ms</th>"
-      "<th>RMS</th><th>max</th><th>Yee %</th><th>visibility %</th><th>max rel. Z</th><th>Pareto front "
+      "<th>RMS</th><th>max</th><th>Yee %</th><th>visibility %</th><th>shared-edge ties %</th><th>max rel. "
+      "Z</th><th>Pareto front "
       "of</th><th>options</th></tr>\n";
   const auto ms = [](double s) {
     char buf[32];
@@ -179,8 +179,9 @@ void writeSweepReport(const std::string& dir, const SweepMeta& meta, const std::
             ms(r.time.median) + "</td><td>" + ms(r.time.min) + "–" + ms(r.time.max) + "</td><td>" +
             ms(r.build.median) + "</td><td>" + ms(r.load.median) + "</td><td>" + sig3(r.errors.rms) +
             "</td><td>" + sig3(r.errors.max) + "</td><td>" + sig3(100.0 * r.errors.perceptual) + "</td><td>" +
-            sig3(100.0 * r.errors.visibility) + "</td><td>" + sig3(r.errors.depthMaxRel) + "</td><td>" +
-            escapeHtml(onFront[r.index]) + "</td><td><code>" + escapeHtml(r.args) + "</code></td></tr>\n";
+            sig3(100.0 * r.errors.visibility) + "</td><td>" + sig3(100.0 * r.errors.visibilitySharedEdge) +
+            "</td><td>" + sig3(r.errors.depthMaxRel) + "</td><td>" + escapeHtml(onFront[r.index]) +
+            "</td><td><code>" + escapeHtml(r.args) + "</code></td></tr>\n";
   }
   body +=
       "</table>\n<p>Data: <a href=\"sweep.csv\">sweep.csv</a>, <a href=\"sweep.json\">sweep.json</a>.</p>\n";

@@ -16,8 +16,9 @@ const std::vector<std::string> kTimeColumns = {"load_s",      "load_min_s",  "lo
                                                "build_min_s", "build_max_s", "frame_s",    "frame_min_s",
                                                "frame_max_s", "time_s",      "time_min_s", "time_max_s"};
 const std::vector<std::string> kErrorColumns = {
-    "rms_error",     "max_error",      "perceptual_error", "visibility_error", "depth_mean_abs",
-    "depth_max_abs", "depth_mean_rel", "depth_max_rel",    "depth_pixels",     "pixels"};
+    "rms_error",      "max_error",     "perceptual_error", "visibility_error", "visibility_shared_edge",
+    "depth_mean_abs", "depth_max_abs", "depth_mean_rel",   "depth_max_rel",    "depth_pixels",
+    "pixels"};
 
 std::string quote(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -38,12 +39,31 @@ std::string num(double v) {
 // The numbers of a row in CSV column order (after args).
 std::vector<double> numbers(const CellResult& r) {
   const CellErrors& e = r.errors;
-  return {double(r.width), double(r.height), double(r.repeat), r.load.median,
-          r.load.min,      r.load.max,       r.build.median,   r.build.min,
-          r.build.max,     r.frame.median,   r.frame.min,      r.frame.max,
-          r.time.median,   r.time.min,       r.time.max,       e.rms,
-          e.max,           e.perceptual,     e.visibility,     e.depthMeanAbs,
-          e.depthMaxAbs,   e.depthMeanRel,   e.depthMaxRel,    double(e.depthPixels),
+  return {double(r.width),
+          double(r.height),
+          double(r.repeat),
+          r.load.median,
+          r.load.min,
+          r.load.max,
+          r.build.median,
+          r.build.min,
+          r.build.max,
+          r.frame.median,
+          r.frame.min,
+          r.frame.max,
+          r.time.median,
+          r.time.min,
+          r.time.max,
+          e.rms,
+          e.max,
+          e.perceptual,
+          e.visibility,
+          e.visibilitySharedEdge,
+          e.depthMeanAbs,
+          e.depthMaxAbs,
+          e.depthMeanRel,
+          e.depthMaxRel,
+          double(e.depthPixels),
           double(e.pixels)};
 }
 
@@ -61,6 +81,7 @@ void setNumbers(CellResult& r, const std::vector<double>& v) {
   e.max = v[i++];
   e.perceptual = v[i++];
   e.visibility = v[i++];
+  e.visibilitySharedEdge = v[i++];
   e.depthMeanAbs = v[i++];
   e.depthMaxAbs = v[i++];
   e.depthMeanRel = v[i++];
@@ -233,6 +254,7 @@ nlohmann::json toJson(const SweepMeta& meta, const std::vector<CellResult>& rows
                      {"max", jsonNumber(e.max)},
                      {"perceptual", jsonNumber(e.perceptual)},
                      {"visibility", jsonNumber(e.visibility)},
+                     {"visibilitySharedEdge", jsonNumber(e.visibilitySharedEdge)},
                      {"depth",
                       {{"meanAbsolute", jsonNumber(e.depthMeanAbs)},
                        {"maxAbsolute", jsonNumber(e.depthMaxAbs)},
@@ -284,11 +306,18 @@ void readJson(const std::string& path, SweepMeta& meta, std::vector<CellResult>&
       c.time = statsFromJson(t.at("time"));
       const nlohmann::json& e = r.at("errors");
       const nlohmann::json& d = e.at("depth");
-      c.errors = {fromJsonNumber(e.at("rms")),          fromJsonNumber(e.at("max")),
-                  fromJsonNumber(e.at("perceptual")),   fromJsonNumber(e.at("visibility")),
-                  fromJsonNumber(d.at("meanAbsolute")), fromJsonNumber(d.at("maxAbsolute")),
-                  fromJsonNumber(d.at("meanRelative")), fromJsonNumber(d.at("maxRelative")),
-                  e.at("pixels").get<uint64_t>(),       d.at("pixels").get<uint64_t>()};
+      CellErrors& x = c.errors;
+      x.rms = fromJsonNumber(e.at("rms"));
+      x.max = fromJsonNumber(e.at("max"));
+      x.perceptual = fromJsonNumber(e.at("perceptual"));
+      x.visibility = fromJsonNumber(e.at("visibility"));
+      x.visibilitySharedEdge = fromJsonNumber(e.at("visibilitySharedEdge"));
+      x.depthMeanAbs = fromJsonNumber(d.at("meanAbsolute"));
+      x.depthMaxAbs = fromJsonNumber(d.at("maxAbsolute"));
+      x.depthMeanRel = fromJsonNumber(d.at("meanRelative"));
+      x.depthMaxRel = fromJsonNumber(d.at("maxRelative"));
+      x.depthPixels = d.at("pixels").get<uint64_t>();
+      x.pixels = e.at("pixels").get<uint64_t>();
       rows.push_back(std::move(c));
     }
   } catch (const nlohmann::json::exception& e) {

@@ -32,9 +32,9 @@ struct SweepMeta {
 // The CSV columns, in order: cell, scene, one per --vary option (its name),
 // args, width, height, repeat, then the times in seconds (load_s, build_s,
 // frame_s, time_s, each a median followed by its _min_s and _max_s) and the
-// errors (rms_error
-// max_error perceptual_error visibility_error depth_mean_abs depth_max_abs
-// depth_mean_rel depth_max_rel depth_pixels pixels).
+// errors (rms_error max_error perceptual_error visibility_error
+// visibility_shared_edge depth_mean_abs depth_max_abs depth_mean_rel
+// depth_max_rel depth_pixels pixels).
 std::vector<std::string> csvColumns(const std::vector<VaryAxis>& vary);
 // The columns that hold times: what may differ between two runs of a cell.
 bool isTimeColumn(const std::string& column);
@@ -49,7 +49,8 @@ std::vector<CellResult> readCsv(const std::string& path, const std::vector<VaryA
 //  vary: [{name, values}], options, reference, repeat}, "reference": text,
 //  "cells", "shard", "rows": [{cell, scene, settings: {name: value}, args,
 //  width, height, repeat, seconds: {load, build, frame, time: {median, min,
-//  max}}, errors: {rms, max, perceptual, visibility, depth: {meanAbsolute,
+//  max}}, errors: {rms, max, perceptual, visibility, visibilitySharedEdge,
+//  depth: {meanAbsolute,
 //  maxAbsolute, meanRelative, maxRelative, pixels}, pixels}}]}
 nlohmann::json toJson(const SweepMeta& meta, const std::vector<CellResult>& rows);
 // Reads a sweep.json; throws InputError (file: path) on another schema or
