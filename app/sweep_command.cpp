@@ -189,9 +189,11 @@ int runSweep(const SweepOptions& opt) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const std::string eta =
           i == 0 ? "" : ", ETA " + duration(elapsed / double(i) * double(todo.size() - i));
+      std::string label = std::filesystem::path(todo[i]->scene).filename().string();
+      for (size_t v = 0; v < spec.vary.size(); ++v)
+        label += ", " + spec.vary[v].name + " " + todo[i]->values[v];
       std::fprintf(stderr, "\r\033[K[%zu/%zu done%s] cell %zu: %s", i, todo.size(), eta.c_str(),
-                   todo[i]->index,
-                   todo[i]->values.empty() ? todo[i]->scene.c_str() : todo[i]->values.front().c_str());
+                   todo[i]->index, label.c_str());
     }
     rows.push_back(sweep::measureCell(*todo[i], spec.repeat, references));
     std::sort(rows.begin(), rows.end(),
@@ -218,7 +220,8 @@ CommandRunner addSweepCommand(CLI::App& app) {
   cmd->add_option("scenes", opt->scenes, "glTF scenes")->check(CLI::ExistingFile);
   cmd->add_option("--vary", opt->vary,
                   "NAME=V1,V2,...: a render option and its values (repeatable; every combination is a cell; "
-                  "several numbers joined by x or :, flags on/off)");
+                  "several numbers joined by x or :, flags on/off)")
+      ->allow_extra_args(false);  // one NAME=... per --vary: a scene after it stays a scene
   cmd->add_option("--reference", opt->reference,
                   "auto (the ray caster at 16 spp, max depth 16, transparency cut-off 0) or a flat EXR")
       ->capture_default_str();

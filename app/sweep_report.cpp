@@ -42,12 +42,13 @@ double time(const CellResult& r) { return r.time.median; }
 
 const std::vector<ErrorMetric>& errorMetrics() {
   static const std::vector<ErrorMetric> metrics = {
-      {"visibility", "visibility disagreement (share of pixel centres)", "",
+      {"visibility", "visibility error", "visibility disagreement (share of pixel centres)", "",
        [](const CellResult& r) { return r.errors.visibility; }},
-      {"rms", "RMS colour error (linear RGBA)", "", [](const CellResult& r) { return r.errors.rms; }},
-      {"perceptual", "perceptual error (share of pixels, Yee)", "",
+      {"rms", "RMS colour error", "RMS colour error (linear RGBA)", "",
+       [](const CellResult& r) { return r.errors.rms; }},
+      {"perceptual", "perceptual error", "perceptual error (share of pixels, Yee)", "",
        [](const CellResult& r) { return r.errors.perceptual; }},
-      {"depth", "max relative depth error (where IDs agree)", "",
+      {"depth", "depth error", "max relative depth error (where IDs agree)", "",
        [](const CellResult& r) { return r.errors.depthMaxRel; }},
   };
   return metrics;
@@ -74,7 +75,7 @@ std::vector<SweepPlot> sweepPlots(const SweepMeta& meta, const std::vector<CellR
       const size_t groupings = std::max<size_t>(vary.size(), 1);
       for (size_t a = 0; a < groupings; ++a) {
         Plot plot;
-        plot.title = baseName(scene) + ": " + metric.quantity + " against time";
+        plot.title = baseName(scene) + ": " + metric.name + " against time";
         plot.x = {"render time (BVH build + frame, median)", "s", AxisScale::Log};
         plot.y = {metric.quantity, metric.unit, AxisScale::Log};
         std::string by = "cells";

@@ -15,6 +15,7 @@ namespace rastray::sweep {
 // One plotted error: its column's value in a row, and how the axis reads.
 struct ErrorMetric {
   const char* key;       // file-name part: "visibility", "rms", ...
+  const char* name;      // short, for the title
   const char* quantity;  // axis label
   const char* unit;      // "" for a share or a dimensionless ratio
   double (*of)(const CellResult&);

@@ -253,6 +253,35 @@ TEST(SweepReference, AutoIsDeterministicAndItsOwnSettingsHaveNoError) {
   EXPECT_GT(raster.errors.perceptual, 0.0);
 }
 
+TEST(SweepReference, AFlatExrWorksAndItsOwnSettingsHaveNoError) {
+  TempDir dir("exr");
+  const std::string scene = kScenes + "/cornell-box.gltf";
+  // Float colour: a half EXR would round the reference's colours.
+  const test::CommandResult made = test::runRastray(
+      {"render", scene, "--renderer", "raytrace", "--size", "12", "8", "--float", "-o", dir / "ref.exr"});
+  ASSERT_EQ(made.status, 0) << made.err;
+  const test::CommandResult r =
+      test::runRastray({"sweep", scene, "--renderer", "raytrace", "--vary", "spp=1,4", "--size", "12", "8",
+                        "--repeat", "1", "--reference", dir / "ref.exr", "--report", dir / "r"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  SweepMeta meta;
+  std::vector<CellResult> rows;
+  readJson(dir / "r/sweep.json", meta, rows);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_NE(meta.reference.find("ref.exr"), std::string::npos);
+  EXPECT_EQ(rows[0].errors.rms, 0.0);
+  EXPECT_EQ(rows[0].errors.visibility, 0.0);
+  EXPECT_EQ(rows[0].errors.depthMaxAbs, 0.0);
+  EXPECT_GT(rows[1].errors.rms, 0.0);  // 4 spp resolves edges differently
+  // A reference of another size is refused before anything runs.
+  const test::CommandResult wrong =
+      test::runRastray({"sweep", scene, "--renderer", "raytrace", "--vary", "spp=1,4", "--size", "16", "8",
+                        "--reference", dir / "ref.exr", "--report", dir / "wrong"});
+  EXPECT_EQ(wrong.status, 2);
+  EXPECT_NE(wrong.err.find("ref.exr"), std::string::npos) << wrong.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "wrong"));
+}
+
 // Two parallel quads 1e-4 apart at distance 10 with the near plane at 1e-3:
 // unorm16 (step about d²/n · 2^-16 = 1.5) and unorm24 (6e-3) cannot tell
 // them apart, float-reversed (relative step 2^-24: 6e-7) can. The far quad
