@@ -1,6 +1,7 @@
 #include "app/sweep_report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -70,7 +71,21 @@ std::vector<SweepPlot> sweepPlots(const SweepMeta& meta, const std::vector<CellR
       front.highlight = true;
       front.markers = false;
       front.colour = int(plotPalette().size()) - 1;  // black
-      for (const size_t i : paretoFront(all)) front.points.push_back(all[i]);
+      // Each cell on the front is labelled with its settings, so the plot
+      // alone says which setting to pick for a given time budget; a label
+      // that would overprint the previous one (closer than about a label's
+      // width and height, in decades) is left to the tooltip.
+      double lastX = -1e300, lastY = -1e300;
+      for (const size_t i : paretoFront(all)) {
+        PlotPoint p = all[i];
+        const double lx = p.x > 0 ? std::log10(p.x) : -1e300, ly = p.y > 0 ? std::log10(p.y) : -1e300;
+        if (std::fabs(lx - lastX) > 0.35 || std::fabs(ly - lastY) > 0.12) {
+          for (const std::string& v : cells[i]->values) p.text += (p.text.empty() ? "" : " ") + v;
+          lastX = lx;
+          lastY = ly;
+        }
+        front.points.push_back(p);
+      }
 
       const size_t groupings = std::max<size_t>(vary.size(), 1);
       for (size_t a = 0; a < groupings; ++a) {
