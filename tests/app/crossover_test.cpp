@@ -1,0 +1,251 @@
+// The crossover study (rastray sweep --crossover): the generated meshes have
+// exactly the triangle count asked for, are deterministic and fill the view;
+// a tiny study writes the CSV and JSON with their schema and valid SVG
+// plots; peak memory, measured per child process, grows with the triangle
+// count; a cell that cannot run is recorded, not fatal.
+#ifdef RASTRAY_HAVE_RENDERERS
+
+#include "app/sweep_crossover.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/render_setup.h"
+#include "app/sweep_crossover_scene.h"
+#include "common/scene.h"
+#include "xml_check.h"
+
+namespace rastray::crossover {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name)
+      : path(fs::temp_directory_path() / ("rastray-crossover-test-" + name)) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+TEST(Crossover, MeshesHaveExactlyTheTrianglesAskedFor) {
+  for (const uint64_t t :
+       {1ull, 2ull, 3ull, 99ull, 100ull, 101ull, 1000ull, 4097ull, 12345ull, 999983ull, 1'000'000ull}) {
+    const GltfScene s = crossoverScene(t, true);
+    ASSERT_EQ(s.meshes.size(), 1u);
+    const GltfMesh& m = s.meshes[0];
+    EXPECT_EQ(m.indices.size(), 3 * t) << t;
+    EXPECT_EQ(m.normals.size(), m.positions.size());
+    uint32_t largest = 0;
+    for (const uint32_t i : m.indices) largest = std::max(largest, i);
+    EXPECT_LT(largest, m.positions.size()) << t;
+  }
+  // Powers of ten are full rectangles of quads, close to square ones.
+  for (uint64_t t = 100; t <= 10'000'000; t *= 10) {
+    const GridShape g = gridShape(t, 1.5);
+    EXPECT_EQ(g.triangles(), t);
+    EXPECT_EQ(g.partialQuads, 0u) << t;
+    EXPECT_FALSE(g.extraTriangle);
+    const double aspect = double(g.columns) / double(g.rows);
+    EXPECT_GT(aspect, 0.75) << t;
+    EXPECT_LT(aspect, 3.0) << t;
+  }
+  EXPECT_THROW(crossoverScene(0, true), std::invalid_argument);
+}
+
+TEST(Crossover, MeshesAreDeterministicAndBothVariantsShareThem) {
+  TempDir dir("deterministic");
+  crossoverScene(20'000, true).writeGlb((dir.path / "a.glb").string());
+  crossoverScene(20'000, true).writeGlb((dir.path / "b.glb").string());
+  const std::string a = readFile(dir.path / "a.glb");
+  EXPECT_GT(a.size(), 20'000u * 12);  // indices alone take 12 bytes a triangle
+  EXPECT_EQ(a, readFile(dir.path / "b.glb"));
+
+  const GltfScene lit = crossoverScene(20'000, true), unlit = crossoverScene(20'000, false);
+  EXPECT_EQ(lit.meshes[0].positions, unlit.meshes[0].positions);
+  EXPECT_EQ(lit.meshes[0].indices, unlit.meshes[0].indices);
+  EXPECT_EQ(lit.lights.size(), 1u);
+  EXPECT_TRUE(unlit.lights.empty());
+  EXPECT_NE(unlit.materials[0].emissive, glm::vec3(0.0f));
+  // The loader reads exactly that many triangles back from the .glb.
+  EXPECT_EQ(loadScene((dir.path / "a.glb").string()).triangles.size(), 20'000u);
+}
+
+// Every pixel sees the surface at 16:9 and 4:3, at a coarse and a fine
+// tessellation: the study measures full frames, not background.
+TEST(Crossover, TheSurfaceFillsTheView) {
+  TempDir dir("fills");
+  for (const uint64_t t : {100ull, 50'000ull}) {
+    const std::string path = (dir.path / ("s" + std::to_string(t) + ".glb")).string();
+    crossoverScene(t, false).writeGlb(path);
+    for (const ImageSize size : {ImageSize{64, 36}, ImageSize{48, 36}})
+      for (const char* renderer : {"raster", "raytrace"}) {
+        RenderSettings settings;
+        settings.rendererName = renderer;
+        settings.camera.size = {size.width, size.height};
+        settings.finish();
+        const Scene scene = loadSceneForRender(path, settings);
+        const RenderRun run = renderScene(scene, settings);
+        int empty = 0;
+        for (const uint32_t id : run.output.image.instance) empty += id == kNoId;
+        EXPECT_EQ(empty, 0) << t << " triangles, " << renderer << " " << size.width << "x" << size.height;
+      }
+  }
+}
+
+CrossoverOptions tinyStudy(const std::string& dir) {
+  CrossoverOptions o;
+  o.reportDir = dir;
+  o.triangles = {100, 200'000};
+  o.sizes = {{80, 60}, {160, 90}};
+  o.maxRuns = 1;
+  o.rastray = RASTRAY_BINARY;
+  o.threads = 1;
+  o.progress = false;
+  return o;
+}
+
+TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
+  TempDir dir("tiny");
+  const CrossoverOptions options = tinyStudy(dir.path.string());
+  StudyMeta meta;
+  const std::vector<CellResult> rows = measureCells(options, meta, {});
+  writeCrossoverReport(options.reportDir, meta, rows);
+  ASSERT_EQ(rows.size(), 2u * 2u * 2u);
+  for (const CellResult& r : rows) {
+    EXPECT_EQ(r.status, "ok") << r.detail;
+    EXPECT_GT(r.visibilitySeconds, 0);
+    EXPECT_GT(r.shadedSeconds, 0);
+    EXPECT_GE(r.runs, 1);
+    EXPECT_GT(r.processSeconds, r.shadedSeconds);  // the process also loads and writes
+    EXPECT_EQ(std::isfinite(r.bvhBuildSeconds), r.renderer == "raytrace");
+    EXPECT_GT(r.visibilityPeakRssBytes, 1u << 20);
+    EXPECT_GT(r.shadedPeakRssBytes, 1u << 20);
+  }
+
+  // CSV: the documented header, one line per row, as many fields as columns.
+  const std::string csv = readFile(dir.path / "crossover.csv");
+  std::istringstream lines(csv);
+  std::string header, line;
+  std::getline(lines, header);
+  EXPECT_EQ(header,
+            "triangles,width,height,pixels,renderer,status,runs,visibility_s,shaded_s,bvh_build_s,process_s,"
+            "visibility_peak_rss_bytes,shaded_peak_rss_bytes,detail");
+  int count = 0;
+  while (std::getline(lines, line)) {
+    ++count;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 13) << line;
+  }
+  EXPECT_EQ(count, 8);
+
+  // JSON: schema, version, machine, one row per cell and a winner per cell.
+  const nlohmann::json j = nlohmann::json::parse(readFile(dir.path / "crossover.json"));
+  EXPECT_EQ(j.at("schema"), "rastray.crossover");
+  EXPECT_EQ(j.at("version"), 1);
+  EXPECT_EQ(j.at("threads"), 1);
+  EXPECT_GT(j.at("machine").at("memoryBytes").get<uint64_t>(), 0u);
+  ASSERT_EQ(j.at("rows").size(), 8u);
+  EXPECT_EQ(j.at("rows")[0].at("seconds").size(), 4u);
+  ASSERT_EQ(j.at("winners").size(), 4u);
+  for (const auto& w : j.at("winners")) {
+    const std::string faster = w.at("shaded").at("faster");
+    EXPECT_TRUE(faster == "raster" || faster == "raytrace");
+    EXPECT_GE(w.at("shaded").at("ratio").get<double>(), 1.0);
+  }
+
+  // Plots: valid XML, labelled axes, every cell placed (the winner maps).
+  for (const char* file :
+       {"crossover-shaded.svg", "crossover-visibility.svg", "crossover-time.svg", "crossover-memory.svg"}) {
+    std::string error;
+    const std::vector<test::Element> elements = test::parseXml(readFile(dir.path / file), &error);
+    EXPECT_TRUE(error.empty()) << file << ": " << error;
+    std::string xTitle, yTitle;
+    for (const test::Element& e : elements) {
+      const auto c = e.attributes.find("class");
+      if (c != e.attributes.end() && c->second == "x-title") xTitle = e.text;
+      if (c != e.attributes.end() && c->second == "y-title") yTitle = e.text;
+    }
+    EXPECT_EQ(xTitle, "triangles") << file;
+    EXPECT_FALSE(yTitle.empty()) << file;
+  }
+  const std::vector<NamedPlot> plots = crossoverPlots(meta, rows);
+  const PlotRender shaded = renderPlot(plots[0].plot);
+  EXPECT_EQ(shaded.drawn, 4u);
+  EXPECT_EQ(shaded.skipped, 0u);
+  EXPECT_NE(readFile(dir.path / "index.html").find("<svg"), std::string::npos);
+
+  // Peak memory grows with the triangle count, for each renderer and size.
+  for (const CellResult& small : rows)
+    for (const CellResult& large : rows)
+      if (small.triangles == 100 && large.triangles == 200'000 && small.renderer == large.renderer &&
+          small.width == large.width) {
+        EXPECT_GT(large.visibilityPeakRssBytes, small.visibilityPeakRssBytes + (8u << 20))
+            << small.renderer << " " << small.width << "x" << small.height;
+        EXPECT_GT(large.shadedPeakRssBytes, small.shadedPeakRssBytes + (8u << 20))
+            << small.renderer << " " << small.width << "x" << small.height;
+      }
+}
+
+// A cell that cannot run is recorded with its reason, and the cells of that
+// renderer at least as large are skipped; the study goes on.
+TEST(Crossover, CellsThatCannotRunAreRecorded) {
+  TempDir dir("fail");
+  CrossoverOptions options = tinyStudy(dir.path.string());
+  // Too little for the dynamic loader to map rastray's libraries: every cell
+  // that runs fails for memory.
+  options.childMemoryLimitBytes = 64ull << 20;
+  StudyMeta meta;
+  const std::vector<CellResult> rows = measureCells(options, meta, {});
+  ASSERT_EQ(rows.size(), 8u);
+  int notOk = 0, skipped = 0;
+  for (const CellResult& r : rows) {
+    if (r.status == "skipped") ++skipped;
+    if (!r.ok()) {
+      ++notOk;
+      EXPECT_FALSE(r.detail.empty());
+      EXPECT_TRUE(std::isnan(r.shadedSeconds));
+    }
+  }
+  EXPECT_EQ(notOk, 8);
+  EXPECT_EQ(skipped, 6);  // each renderer's first cell failed: every larger one is skipped
+  for (const CellResult& r : rows) {
+    if (r.status != "skipped") {
+      EXPECT_EQ(r.status, "out of memory") << r.detail;
+    }
+  }
+  writeCrossoverReport(options.reportDir, meta, rows);
+  EXPECT_NE(readFile(dir.path / "crossover.csv").find("skipped"), std::string::npos);
+
+  options.rastray = "/nonexistent/rastray";
+  options.childMemoryLimitBytes = 0;
+  const std::vector<CellResult> none = measureCells(options, meta, {});
+  int failed = 0;
+  for (const CellResult& r : none) {
+    EXPECT_TRUE(r.status == "failed" || r.status == "skipped") << r.status;
+    if (r.status == "failed") {
+      ++failed;
+      EXPECT_NE(r.detail.find("could not run /nonexistent/rastray"), std::string::npos) << r.detail;
+    }
+  }
+  EXPECT_EQ(failed, 2);
+}
+
+}  // namespace
+}  // namespace rastray::crossover
+
+#endif  // RASTRAY_HAVE_RENDERERS
