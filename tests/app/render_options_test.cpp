@@ -125,6 +125,7 @@ std::optional<InputError> finishWith(const Args& args, bool withRenderer = true,
     return e;
   }
   if (out) {
+    settings.camera.detach();  // its option pointers point into `app` too
     *out = settings;
     out->cliOptions.clear();  // they point into `app`
   }
