@@ -384,7 +384,9 @@ TEST(FarFromOriginOffsets, LitSceneBaked1e6OffByLessThanOnePercent) {
     EXPECT_LT(off[1][0], 0.01) << "--origin world, error-bound, offset " << offset.y;
     // Offset in y too, the floor's normal axis: the RTG offset, 16 units up
     // from it there, loses the box's and the sphere's shadows.
-    if (offset.y != 0.0) EXPECT_GT(off[1][1], 0.02) << "--origin world, float-ulps";
+    if (offset.y != 0.0) {
+      EXPECT_GT(off[1][1], 0.02) << "--origin world, float-ulps";
+    }
   }
 }
 
