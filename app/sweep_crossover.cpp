@@ -452,14 +452,26 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
   // pixels as one of them is skipped.
   std::vector<std::pair<uint64_t, uint64_t>> failed[2];
   for (const uint64_t t : meta.triangles) {
-    // The two variants of this count, written once for all its cells; the
-    // meshes are freed before any child runs.
-    const std::string lit = scratch.path + "/lit-" + std::to_string(t) + ".glb";
-    const std::string unlit = scratch.path + "/unlit-" + std::to_string(t) + ".glb";
-    crossoverScene(t, true).writeGlb(lit);
-    crossoverScene(t, false).writeGlb(unlit);
+    std::string lit, unlit;
+    double aspect = 0;
     for (const ImageSize& s : meta.sizes)
       for (int k = 0; k < 2; ++k) {
+        // The two variants of this count for this size's aspect ratio, written
+        // once for the sizes that share it (the sizes are in order); the
+        // meshes are freed before any child runs.
+        const double sizeAspect = double(s.width) / double(s.height);
+        if (sizeAspect != aspect) {
+          if (!lit.empty()) {
+            std::filesystem::remove(lit);
+            std::filesystem::remove(unlit);
+          }
+          aspect = sizeAspect;
+          const std::string name = std::to_string(t) + "-" + sizeText(s.width, s.height) + ".glb";
+          lit = scratch.path + "/lit-" + name;
+          unlit = scratch.path + "/unlit-" + name;
+          crossoverScene(t, true, aspect).writeGlb(lit);
+          crossoverScene(t, false, aspect).writeGlb(unlit);
+        }
         CellResult r;
         r.triangles = t;
         r.width = s.width;
@@ -498,8 +510,10 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
         rows.push_back(r);
         if (onCell) onCell(r, rows.size(), total);
       }
-    std::filesystem::remove(lit);
-    std::filesystem::remove(unlit);
+    if (!lit.empty()) {
+      std::filesystem::remove(lit);
+      std::filesystem::remove(unlit);
+    }
   }
   meta.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return rows;
@@ -515,7 +529,9 @@ void writeCrossoverReport(const std::string& dir, const StudyMeta& meta,
   std::string body = "<h1>Rasterizer against ray caster: where each wins</h1>\n";
   body +=
       "<p>Generated terrain meshes of " + countText(meta.triangles.front()) + " to " +
-      countText(meta.triangles.back()) + " triangles (the same surface, tessellated finer), rendered at " +
+      countText(meta.triangles.back()) +
+      " triangles (the same surface, tessellated finer as a regular grid in screen space: every triangle "
+      "covers about pixels / triangles pixels), rendered at " +
       sizeText(meta.sizes.front().width, meta.sizes.front().height) + " to " +
       sizeText(meta.sizes.back().width, meta.sizes.back().height) +
       ", 1 spp, each render in its own process. <b>Primary visibility</b>: the scene with an emissive "
