@@ -144,6 +144,9 @@ int runSweep(const SweepOptions& opt) {
     for (const std::string& a : sweep::autoReferenceArgs()) meta.reference += " " + a;
     meta.reference += ", at each cell's --size, camera options and --cull";
   } else {
+    if (spec.scenes.size() > 1)
+      throw InputError("command line", "--reference",
+                       "an EXR reference shows one scene; give one scene (or --reference auto)");
     const sweep::Reference& r = references.referenceFor(cells.front());
     meta.reference = r.description;
     for (const sweep::Cell& c : cells)
