@@ -1,6 +1,5 @@
 #include "raytrace/embree_scene.h"
 
-#include <cstdio>
 #include <stdexcept>
 
 #include "common/error.h"
@@ -36,10 +35,13 @@ bool needsFilter(const Material& material, bool sceneNeedsFilters, CullMode cull
   return sceneNeedsFilters && (material.alphaMode != AlphaMode::Opaque || material.isRefractive());
 }
 
+// Called by Embree on the thread that made the failing call, possibly
+// inside a traversal: it cannot throw through Embree and must not print
+// (the libraries never write to stderr), so it keeps the first message and
+// throwIfError() raises it on the caller's side of the call.
 void EmbreeScene::onError(void* userPtr, RTCError code, const char* message) {
   auto* self = static_cast<EmbreeScene*>(userPtr);
   const std::string text = std::string("embree: ") + errorName(code) + ": " + (message ? message : "");
-  std::fprintf(stderr, "rastray: %s\n", text.c_str());
   std::lock_guard<std::mutex> lock(self->errorMutex_);
   if (self->firstError_.empty()) self->firstError_ = text;
 }

@@ -50,8 +50,9 @@ class EmbreeScene {
   RTCScene handle() const { return scene_; }
   bool hasFilters() const { return filterGeometries_ > 0; }
   size_t filterGeometries() const { return filterGeometries_; }
-  // Throws std::runtime_error with the first error the device reported
-  // since the last call (the callback cannot throw through Embree).
+  // Throws std::runtime_error("embree: <error>: <message>") with the first
+  // error the device reported since the last call (the callback cannot
+  // throw through Embree, and does not print); app/ prints it as one line.
   void throwIfError();
 
  private:
