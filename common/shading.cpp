@@ -35,20 +35,26 @@ Shader::Shader(const Scene& scene, const SceneAnalysis& analysis, const Camera& 
       options_(options),
       visibility_(visibility),
       secondary_(secondary),
-      textures_(analysis.textures ? TextureSet(scene) : TextureSet()),
+      textures_(std::make_shared<const TextureSet>(analysis.textures ? TextureSet(scene) : TextureSet())),
       eyeLight_(analysis.eyeLight) {}
+
+Shader::Shader(const Shader& shading, const LightVisibility* visibility, const SecondaryRayTracer* secondary)
+    : Shader(shading) {
+  visibility_ = visibility;
+  secondary_ = secondary;
+}
 
 glm::vec4 Shader::baseColor(const SurfacePoint& p, const TextureFootprint& footprint) const {
   glm::vec4 c = p.material->baseColorFactor;
-  if (p.material->baseColorTexture >= 0 && !textures_.empty())
-    c *= textures_.sample(p.material->baseColorTexture, p.uv, footprint, options_.textureFilter);
+  if (p.material->baseColorTexture >= 0 && !textures_->empty())
+    c *= textures_->sample(p.material->baseColorTexture, p.uv, footprint, options_.textureFilter);
   return c * p.color;  // glTF: factor × texture × COLOR_0
 }
 
 glm::vec3 Shader::emission(const SurfacePoint& p, const TextureFootprint& footprint) const {
   glm::vec3 e = p.material->emissive;
-  if (p.material->emissiveTexture >= 0 && !textures_.empty() && e != glm::vec3(0.0f))
-    e *= glm::vec3(textures_.sample(p.material->emissiveTexture, p.uv, footprint, options_.textureFilter));
+  if (p.material->emissiveTexture >= 0 && !textures_->empty() && e != glm::vec3(0.0f))
+    e *= glm::vec3(textures_->sample(p.material->emissiveTexture, p.uv, footprint, options_.textureFilter));
   return e;
 }
 

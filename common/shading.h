@@ -31,6 +31,7 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <memory>
 
 #include "common/analysis.h"
 #include "common/camera.h"
@@ -84,6 +85,11 @@ class Shader {
   Shader(const Scene& scene, const SceneAnalysis& analysis, const Camera& camera,
          const ShadingOptions& options, const LightVisibility* visibility,
          const SecondaryRayTracer* secondary);
+  // The same shading (scene, camera, options, and the decoded textures,
+  // shared) calling back into other visibility and secondary-ray objects:
+  // how a renderer shades one traced pixel through callbacks that record
+  // its rays, while its other pixels keep the first Shader.
+  Shader(const Shader& shading, const LightVisibility* visibility, const SecondaryRayTracer* secondary);
 
   // Straight linear RGBA base colour (factor × texture × COLOR_0) at a point.
   glm::vec4 baseColor(const SurfacePoint& point, const TextureFootprint& footprint) const;
@@ -103,7 +109,7 @@ class Shader {
   // refractive ones.
   glm::vec3 shadowTransmittance(const SurfacePoint& point) const;
 
-  const TextureSet& textures() const { return textures_; }
+  const TextureSet& textures() const { return *textures_; }
   const ShadingOptions& options() const { return options_; }
 
  private:
@@ -115,7 +121,7 @@ class Shader {
   ShadingOptions options_;
   const LightVisibility* visibility_;
   const SecondaryRayTracer* secondary_;
-  TextureSet textures_;
+  std::shared_ptr<const TextureSet> textures_;  // never null; shared by the copies above
   bool eyeLight_;
 };
 

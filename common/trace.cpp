@@ -38,9 +38,11 @@ std::vector<TraceEvent> TraceLog::events() const {
   return events_;
 }
 
-std::string TraceLog::text() const {
+std::string TraceLog::text() const { return traceText(events()); }
+
+std::string traceText(const std::vector<TraceEvent>& events) {
   std::string out;
-  for (const TraceEvent& e : events()) {
+  for (const TraceEvent& e : events) {
     out += std::string(2 * size_t(e.depth > 0 ? e.depth : 0), ' ');
     out += toString(e.stage);
     if (e.sample >= 0) out += " sample " + std::to_string(e.sample);

@@ -59,6 +59,10 @@ class TraceSink {
   virtual void record(TraceEvent event) = 0;
 };
 
+// One line per event: "<stage> [sample s] [instance i triangle t]: name v ... -> outcome",
+// indented by depth; what `explain` and `--debug-pixel` print.
+std::string traceText(const std::vector<TraceEvent>& events);
+
 // Keeps the events in arrival order (thread-safe). The order within one
 // thread is the order the renderer did things; the traced pixel's work runs
 // on one thread per pass, so a pixel's log reads top-down.
@@ -66,8 +70,7 @@ class TraceLog : public TraceSink {
  public:
   void record(TraceEvent event) override;
   std::vector<TraceEvent> events() const;
-  // One line per event: "<stage> [sample s] [instance i triangle t]: name v ... -> outcome",
-  // indented by depth; what `explain` and `--debug-pixel` print.
+  // traceText(events()).
   std::string text() const;
 
  private:
