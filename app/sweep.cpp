@@ -193,7 +193,7 @@ VaryAxis parseVary(const std::string& text) {
 
 const std::vector<std::string>& autoReferenceArgs() {
   static const std::vector<std::string> args = {
-      "--renderer", "raytrace", "--spp", "16", "--max-depth", "16", "--transparency-cutoff", "0"};
+      "--renderer", "raytrace", "--spp", "64", "--max-depth", "16", "--transparency-cutoff", "0"};
   return args;
 }
 

@@ -39,8 +39,11 @@ struct VaryAxis {
 // names are checked by planCells).
 VaryAxis parseVary(const std::string& text);
 
-// The settings that make the reference `auto`: the ray caster at 16 spp
-// (the D3D 16x pattern), every transparent layer composited
+// The settings that make the reference `auto`: the ray caster at 64 spp
+// (the 8×8 grid of cell centres, SPEC §3: 4× the largest Direct3D pattern,
+// and at positions none of the 1-16 spp patterns uses, so a cell does not
+// score an edge error of 0 merely by sharing the reference's samples),
+// every transparent layer composited
 // (--transparency-cutoff 0) and secondary rays to depth 16, the rest at
 // their defaults (shadow rays, the file's texture samplers, origin camera,
 // error-bound ray offsets). The cell's image size, camera options and

@@ -226,7 +226,7 @@ CommandRunner addSweepCommand(CLI::App& app) {
                   "several numbers joined by x or :, flags on/off)")
       ->allow_extra_args(false);  // one NAME=... per --vary: a scene after it stays a scene
   cmd->add_option("--reference", opt->reference,
-                  "auto (the ray caster at 16 spp, max depth 16, transparency cut-off 0) or a flat EXR")
+                  "auto (the ray caster at 64 spp, max depth 16, transparency cut-off 0) or a flat EXR")
       ->capture_default_str();
   cmd->add_option("--repeat", opt->repeat, "Renders per cell (median and min-max of the time)")
       ->check(CLI::Range(1, 1000))
