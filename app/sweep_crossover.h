@@ -16,8 +16,9 @@
 // - the child's wall time (load, analysis, render, writing the image);
 // - peak resident memory of each variant's process (libraries and the loaded
 //   scene included).
-// Times are the child's own (renderScene's clock), median of 3 runs when a
-// run takes under a second (--quick: 1 run), else of 1. A cell that runs out of memory (each
+// Times are the child's own (renderScene's clock), the fastest of 3 runs
+// when a run takes under 5 s (--quick: 1 run), else of 1: other work on the
+// machine only ever adds time. A cell that runs out of memory (each
 // child's address space is limited to 85% of the memory available when the
 // study starts), is killed or times out is recorded as such; the larger
 // cells of that renderer (at least as many triangles and pixels) are then
@@ -72,7 +73,7 @@ struct CellResult {
   std::string renderer;  // "raster" or "raytrace"
   std::string status;    // "ok", "out of memory", "killed", "timeout", "failed", "skipped"
   std::string detail;    // why, when not ok
-  int runs = 0;          // runs per scene variant the medians are of
+  int runs = 0;          // runs per scene variant the fastest was taken from (the fewer of the two)
   double visibilitySeconds, shadedSeconds, bvhBuildSeconds, processSeconds;  // NaN: not measured
   // Peak resident memory of the visibility and of the shaded frame's
   // processes (the largest over their runs); 0: not measured.
@@ -92,6 +93,10 @@ struct StudyMeta {
   std::vector<uint64_t> triangles;
   std::vector<ImageSize> sizes;
   double seconds = 0;  // the whole study's wall time
+  // The machine's 1-minute load average at the start and the end (NaN:
+  // unknown): other work on the machine slows the cells down.
+  double loadStart, loadEnd;
+  StudyMeta();
 };
 
 // For one triangle count and size: which renderer is faster and by how much
@@ -110,7 +115,8 @@ std::vector<std::string> csvColumns();
 std::string toCsv(const std::vector<CellResult>& rows);
 
 // {"schema": "rastray.crossover", "version": 1, "quick", "threads",
-//  "machine": {"cpu", "hardwareThreads", "memoryBytes"}, "childMemoryLimitBytes",
+//  "machine": {"cpu", "hardwareThreads", "memoryBytes", "loadAverage": {"start", "end"}},
+//  "childMemoryLimitBytes",
 //  "spp": 1, "scene": text, "triangles": [..], "sizes": [[w, h], ..], "seconds",
 //  "rows": [{"triangles", "width", "height", "pixels", "renderer", "status",
 //            "detail", "runs", "seconds": {"visibility", "shaded", "bvhBuild",

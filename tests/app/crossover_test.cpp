@@ -168,6 +168,7 @@ TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
   EXPECT_EQ(j.at("version"), 1);
   EXPECT_EQ(j.at("threads"), 1);
   EXPECT_GT(j.at("machine").at("memoryBytes").get<uint64_t>(), 0u);
+  EXPECT_TRUE(j.at("machine").at("loadAverage").at("start").is_number());
   ASSERT_EQ(j.at("rows").size(), 8u);
   EXPECT_EQ(j.at("rows")[0].at("seconds").size(), 4u);
   ASSERT_EQ(j.at("winners").size(), 4u);
