@@ -10,6 +10,7 @@
 #include "app/commands.h"
 #include "common/analysis.h"
 #include "common/camera.h"
+#include "common/gltf/loader.h"
 #include "common/scene.h"
 
 namespace rastray {

@@ -14,6 +14,7 @@
 #include "app/cli_options.h"
 #include "common/analysis.h"
 #include "common/camera.h"
+#include "common/gltf/loader.h"
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "raster/rasterizer.h"

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "common/gltf_writer.h"
+#include "common/gltf/writer.h"
 
 namespace rastray::stability {
 

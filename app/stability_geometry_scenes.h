@@ -18,7 +18,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "common/gltf_writer.h"
+#include "common/gltf/writer.h"
 
 namespace rastray::stability {
 

@@ -15,6 +15,7 @@
 
 #include "common/analysis.h"
 #include "common/camera.h"
+#include "common/gltf/loader.h"
 #include "common/scene.h"
 #include "raster/rasterizer.h"
 #include "raytrace/ray_caster.h"

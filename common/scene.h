@@ -211,10 +211,8 @@ struct Scene {
   size_t triangleCount() const { return triangles.size(); }
 };
 
-// Loads a .gltf (external or data-URI buffers) or .glb file. Throws
-// InputError naming the file and the element for every kind of bad input
-// (SPEC §7); never returns a partially checked scene.
-Scene loadScene(const std::string& path);
+// Scenes come from common/gltf/loader.h (loadScene) and are written by
+// common/gltf/writer.h; this header is the model only.
 
 // Moves the scene's frame so that world point `origin` is at (0, 0, 0):
 // positions are rounded again from worldPositions, and lights, the camera

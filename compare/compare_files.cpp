@@ -5,6 +5,7 @@
 #include <tuple>
 
 #include "common/error.h"
+#include "common/gltf/loader.h"
 #include "common/image.h"
 #include "common/scene.h"
 

@@ -10,7 +10,7 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
-#include "common/gltf_writer.h"
+#include "common/gltf/writer.h"
 #include "run_command.h"
 
 namespace rastray {

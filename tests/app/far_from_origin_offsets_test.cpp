@@ -30,7 +30,7 @@
 
 #include "app/render_setup.h"
 #include "app/stability_measure.h"
-#include "common/gltf_writer.h"
+#include "common/gltf/writer.h"
 #include "common/sampling.h"
 #include "common/surface.h"
 

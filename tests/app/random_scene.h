@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-#include "common/gltf_writer.h"
+#include "common/gltf/writer.h"
 
 namespace rastray::test {
 

@@ -14,7 +14,8 @@
 
 #include "app/render_setup.h"
 #include "common/camera.h"
-#include "common/gltf_writer.h"
+#include "common/gltf/loader.h"
+#include "common/gltf/writer.h"
 #include "common/scene.h"
 
 namespace rastray {

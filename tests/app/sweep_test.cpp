@@ -21,7 +21,7 @@
 #include "app/sweep_report.h"
 #include "app/sweep_table.h"
 #include "common/error.h"
-#include "common/gltf_writer.h"
+#include "common/gltf/writer.h"
 #include "run_command.h"
 #include "xml_check.h"
 

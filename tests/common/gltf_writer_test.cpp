@@ -10,7 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "common/gltf_writer.h"
+#include "common/gltf/loader.h"
+#include "common/gltf/writer.h"
 #include "common/scene.h"
 
 namespace rastray {

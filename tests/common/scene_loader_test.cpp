@@ -13,6 +13,7 @@
 
 #include "common/camera.h"
 #include "common/error.h"
+#include "common/gltf/loader.h"
 #include "common/scene.h"
 
 // Readable failure messages for the GLM vectors compared below.

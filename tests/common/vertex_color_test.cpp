@@ -14,6 +14,7 @@
 
 #include "common/analysis.h"
 #include "common/error.h"
+#include "common/gltf/loader.h"
 #include "common/image.h"
 #include "common/scene.h"
 #include "common/shading.h"

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "common/gltf/loader.h"
 #include "frames.h"
 
 namespace rastray {

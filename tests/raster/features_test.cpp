@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "common/gltf/loader.h"
 #include "common/sampling.h"
 #include "raster/rasterizer.h"
 #include "raster_test_util.h"

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <random>
 
+#include "common/gltf/loader.h"
 #include "common/sampling.h"
 #include "common/surface.h"
 #include "common/texture.h"

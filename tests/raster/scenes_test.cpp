@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "common/gltf/loader.h"
 #include "raster/rasterizer.h"
 #include "raster_test_util.h"
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "common/gltf/loader.h"
 #include "raster/rasterizer.h"
 #include "raster/resolve.h"
 #include "raster_test_util.h"

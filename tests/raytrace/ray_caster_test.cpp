@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/gltf/loader.h"
 #include "common/sampling.h"
 #include "common/shading.h"
 #include "test_scenes.h"

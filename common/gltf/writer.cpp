@@ -1,4 +1,4 @@
-#include "common/gltf_writer.h"
+#include "common/gltf/writer.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "common/gltf_check.h"
+#include "common/gltf/check.h"
 
 #include <cmath>
 #include <set>
@@ -226,10 +226,12 @@ std::string supportedExtensionList() {
   return s;
 }
 
-void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
-  Checker c(context, doc);
-  if (!doc.is_object()) c.fail("", std::string("the document must be a JSON object, got ") + typeName(doc));
+namespace {
 
+// The steps of checkGltfDocument, in the order it runs them: each checks
+// one kind of element and throws on its first problem.
+
+void checkAsset(const Checker& c, const json& doc) {
   // asset.version: only 2.x.
   const json* asset = c.member(doc, "asset");
   if (!asset) c.fail("asset", "is missing");
@@ -237,7 +239,9 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
   const std::string version = c.string(*asset, "version", "asset", true);
   if (version.empty() || version[0] != '2' || (version.size() > 1 && version[1] != '.'))
     c.fail("asset", "version \"" + version + "\": only glTF 2.x is supported");
+}
 
+void checkExtensionLists(const Checker& c, const json& doc) {
   for (const char* key : {"extensionsUsed", "extensionsRequired"}) {
     const json* list = c.member(doc, key);
     if (!list) continue;
@@ -249,9 +253,11 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
                         " is required but not supported (supported: " + supportedExtensionList() + ")");
     }
   }
+}
 
-  // Buffers and views first: accessors and images check their ranges
-  // against the declared byte lengths, which tinygltf enforces on load.
+// Buffers and views come first: accessors and images check their ranges
+// against the declared byte lengths, which tinygltf enforces on load.
+std::vector<int64_t> checkBuffers(const Checker& c, const json& doc, const GltfCheckContext& context) {
   std::vector<int64_t> bufferLength;
   if (const json* buffers = c.objectArray(doc, "buffers", "buffers")) {
     for (size_t i = 0; i < buffers->size(); ++i) {
@@ -270,8 +276,16 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       bufferLength.push_back(length);
     }
   }
+  return bufferLength;
+}
 
-  std::vector<int64_t> viewLength, viewStride;
+// Byte length and stride (0: tightly packed) of every bufferView.
+struct ViewRanges {
+  std::vector<int64_t> length, stride;
+};
+
+ViewRanges checkBufferViews(const Checker& c, const json& doc, const std::vector<int64_t>& bufferLength) {
+  ViewRanges r;
   if (const json* views = c.objectArray(doc, "bufferViews", "bufferViews")) {
     for (size_t i = 0; i < views->size(); ++i) {
       const std::string e = "bufferView " + std::to_string(i);
@@ -288,11 +302,14 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
         c.fail(e, "bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) +
                       ") lie outside buffer " + std::to_string(buffer) + " (" +
                       std::to_string(bufferLength[size_t(buffer)]) + " bytes)");
-      viewLength.push_back(length);
-      viewStride.push_back(stride);
+      r.length.push_back(length);
+      r.stride.push_back(stride);
     }
   }
+  return r;
+}
 
+void checkAccessors(const Checker& c, const json& doc, const ViewRanges& views) {
   if (const json* accessors = c.objectArray(doc, "accessors", "accessors")) {
     for (size_t i = 0; i < accessors->size(); ++i) {
       const std::string e = "accessor " + std::to_string(i);
@@ -318,15 +335,15 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       c.numberArray(a, "max", e, size_t(components), size_t(components));
       const int64_t elementSize = size * components;
       if (view >= 0) {
-        const int64_t stride = viewStride[size_t(view)] ? viewStride[size_t(view)] : elementSize;
+        const int64_t stride = views.stride[size_t(view)] ? views.stride[size_t(view)] : elementSize;
         if (stride < elementSize)
           c.fail(e, "bufferView " + std::to_string(view) + " byteStride " + std::to_string(stride) +
                         " is smaller than the element size " + std::to_string(elementSize));
         const int64_t needed = stride * (count - 1) + elementSize;
-        if (!fits(offset, needed, viewLength[size_t(view)]))
+        if (!fits(offset, needed, views.length[size_t(view)]))
           c.fail(e, std::to_string(count) + " elements from byte " + std::to_string(offset) + " need " +
                         std::to_string(offset + needed) + " bytes, bufferView " + std::to_string(view) +
-                        " has " + std::to_string(viewLength[size_t(view)]));
+                        " has " + std::to_string(views.length[size_t(view)]));
       }
       if (const json* sparse = c.member(a, "sparse")) {
         const std::string se = e + " sparse";
@@ -346,16 +363,18 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
         const int64_t ict = c.integer(*indices, "componentType", se + " indices", true);
         if (ict != 5121 && ict != 5123 && ict != 5125)
           c.fail(se + " indices", "\"componentType\" " + std::to_string(ict) + " must be 5121, 5123 or 5125");
-        if (!fits(io, componentSize(ict) * sparseCount, viewLength[size_t(iv)]))
+        if (!fits(io, componentSize(ict) * sparseCount, views.length[size_t(iv)]))
           c.fail(se + " indices", "lie outside bufferView " + std::to_string(iv));
         const int64_t vv = c.index(*values, "bufferView", se + " values", "bufferViews", true);
         const int64_t vo = c.integer(*values, "byteOffset", se + " values", false, 0);
-        if (!fits(vo, elementSize * sparseCount, viewLength[size_t(vv)]))
+        if (!fits(vo, elementSize * sparseCount, views.length[size_t(vv)]))
           c.fail(se + " values", "lie outside bufferView " + std::to_string(vv));
       }
     }
   }
+}
 
+void checkImagesAndTextures(const Checker& c, const json& doc) {
   if (const json* images = c.objectArray(doc, "images", "images")) {
     for (size_t i = 0; i < images->size(); ++i) {
       const std::string e = "image " + std::to_string(i);
@@ -391,7 +410,9 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       c.index(t, "source", e, "images");
     }
   }
+}
 
+void checkMaterials(const Checker& c, const json& doc) {
   if (const json* materials = c.objectArray(doc, "materials", "materials")) {
     for (size_t i = 0; i < materials->size(); ++i) {
       const std::string e = "material " + std::to_string(i);
@@ -434,7 +455,9 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       }
     }
   }
+}
 
+void checkMeshes(const Checker& c, const json& doc) {
   if (const json* meshes = c.objectArray(doc, "meshes", "meshes")) {
     for (size_t i = 0; i < meshes->size(); ++i) {
       const std::string e = "mesh " + std::to_string(i);
@@ -458,7 +481,9 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       }
     }
   }
+}
 
+void checkCameras(const Checker& c, const json& doc) {
   if (const json* cameras = c.objectArray(doc, "cameras", "cameras")) {
     for (size_t i = 0; i < cameras->size(); ++i) {
       const std::string e = "camera " + std::to_string(i);
@@ -493,7 +518,10 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       }
     }
   }
+}
 
+// Returns the number of KHR_lights_punctual lights, which nodes refer to.
+size_t checkLights(const Checker& c, const json& doc) {
   size_t lightCount = 0;
   if (const json* ext = c.member(doc, "extensions")) {
     c.object(*ext, "extensions");
@@ -525,7 +553,10 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       }
     }
   }
+  return lightCount;
+}
 
+void checkNodes(const Checker& c, const json& doc, size_t lightCount) {
   if (const json* nodes = c.objectArray(doc, "nodes", "nodes")) {
     for (size_t i = 0; i < nodes->size(); ++i) {
       const std::string e = "node " + std::to_string(i);
@@ -565,7 +596,9 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       }
     }
   }
+}
 
+void checkScenes(const Checker& c, const json& doc) {
   if (const json* scenes = c.objectArray(doc, "scenes", "scenes")) {
     for (size_t i = 0; i < scenes->size(); ++i) {
       const std::string e = "scene " + std::to_string(i);
@@ -587,6 +620,26 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
       c.fail("scene", "scene " + std::to_string(scene) + " does not exist (" +
                           std::to_string(c.countOf("scenes")) + " scenes)");
   }
+}
+
+}  // namespace
+
+void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
+  Checker c(context, doc);
+  if (!doc.is_object()) c.fail("", std::string("the document must be a JSON object, got ") + typeName(doc));
+
+  checkAsset(c, doc);
+  checkExtensionLists(c, doc);
+  const std::vector<int64_t> bufferLength = checkBuffers(c, doc, context);
+  const ViewRanges views = checkBufferViews(c, doc, bufferLength);
+  checkAccessors(c, doc, views);
+  checkImagesAndTextures(c, doc);
+  checkMaterials(c, doc);
+  checkMeshes(c, doc);
+  checkCameras(c, doc);
+  const size_t lightCount = checkLights(c, doc);
+  checkNodes(c, doc, lightCount);
+  checkScenes(c, doc);
 }
 
 }  // namespace rastray

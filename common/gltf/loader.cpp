@@ -2,7 +2,7 @@
 //
 // Three steps, each refusing bad input with the element named:
 // 1. read the file; for .glb, check the container (header, chunk lengths);
-// 2. parse the JSON and check its structure (gltf_check.h): types,
+// 2. parse the JSON and check its structure (check.h): types,
 //    references, byte ranges;
 // 3. let tinygltf load the resources (buffers from data URIs, external
 //    files or the BIN chunk; images decoded by stb), then walk the scene
@@ -22,7 +22,8 @@
 #include <nlohmann/json.hpp>
 
 #include "common/error.h"
-#include "common/gltf_check.h"
+#include "common/gltf/check.h"
+#include "common/gltf/loader.h"
 #include "common/scene.h"
 
 namespace rastray {
@@ -272,7 +273,7 @@ double readComponent(const uint8_t* p, int64_t componentType, bool normalized) {
   }
 }
 
-// Types and component types were checked (gltf_check), so both are > 0.
+// Types and component types were checked (check.cpp), so both are > 0.
 size_t componentBytes(int64_t componentType) { return size_t(componentSize(componentType)); }
 size_t typeComponents(const std::string& type) { return size_t(componentCount(type)); }
 
@@ -1041,78 +1042,6 @@ Scene loadScene(const std::string& path) {
       throw InputError(path, "buffer " + std::to_string(i), "is shorter than its byteLength");
 
   return SceneBuilder(path, doc, model).build();
-}
-
-glm::dvec3 faceNormal(const Scene& scene, uint32_t instance, uint32_t tri) {
-  const glm::uvec3 t = scene.triangle(instance, tri);
-  const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
-  return glm::cross(b - a, c - a);
-}
-
-bool isDegenerate(const Scene& scene, size_t storedTriangle) {
-  const glm::uvec3 t = scene.triangles[storedTriangle];
-  const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
-  return glm::cross(b - a, c - a) == glm::dvec3(0.0);
-}
-
-void rebaseScene(Scene& scene, const glm::dvec3& origin) {
-  RASTRAY_CHECK(scene.worldPositions.size() == scene.positions.size(), "rebaseScene needs worldPositions");
-  if (!(std::isfinite(origin.x) && std::isfinite(origin.y) && std::isfinite(origin.z)))
-    throw InputError("command line", "--origin", "the render origin is not finite");
-  const glm::dvec3 shift = origin - scene.origin;
-  constexpr double kFloatMax = std::numeric_limits<float>::max();
-  Bounds bounds;
-  for (size_t i = 0; i < scene.positions.size(); ++i) {
-    const glm::dvec3 p = scene.worldPositions[i] - origin;
-    if (!(std::abs(p.x) <= kFloatMax && std::abs(p.y) <= kFloatMax && std::abs(p.z) <= kFloatMax))
-      throw InputError(scene.path, "vertex " + std::to_string(i),
-                       "does not fit a float relative to the render origin");
-    scene.positions[i] = glm::vec3(p);
-    bounds.extend(glm::dvec3(scene.positions[i]));
-  }
-  scene.bounds = bounds;
-  for (Light& light : scene.lights) light.position -= shift;
-  if (scene.camera) scene.camera->worldFromCamera[3] -= glm::dvec4(shift, 0.0);
-  for (Instance& inst : scene.instances) {
-    inst.degenerateCount = 0;
-    for (uint32_t t = 0; t < inst.triangleCount; ++t)
-      if (isDegenerate(scene, inst.firstTriangle + t)) ++inst.degenerateCount;
-  }
-  scene.origin = origin;
-}
-
-std::string IgnoredFeature::describe() const {
-  const std::string plural = count == 1 ? "" : "s";
-  if (unit.empty()) return std::to_string(count) + " " + feature + plural;
-  return feature + " on " + std::to_string(count) + " " + unit + plural;
-}
-
-const char* toString(AlphaMode mode) {
-  switch (mode) {
-    case AlphaMode::Opaque:
-      return "OPAQUE";
-    case AlphaMode::Mask:
-      return "MASK";
-    case AlphaMode::Blend:
-      return "BLEND";
-  }
-  return "?";
-}
-
-const char* toString(LightType type) {
-  switch (type) {
-    case LightType::Point:
-      return "point";
-    case LightType::Spot:
-      return "spot";
-    case LightType::Directional:
-      return "directional";
-  }
-  return "?";
-}
-
-const char* toString(Projection projection) {
-  return projection == Projection::Perspective ? "perspective" : "orthographic";
 }
 
 }  // namespace rastray

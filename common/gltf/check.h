@@ -1,5 +1,5 @@
 // Structural check of a glTF 2.0 JSON document, run before tinygltf sees
-// it (scene_loader.cpp).
+// it (loader.cpp).
 //
 // tinygltf treats a property of the wrong type as absent and does not
 // check references or byte ranges; some of those reach its image loader as
