@@ -337,6 +337,55 @@ nlohmann::json toJson(const StudyMeta& meta, const std::vector<CellResult>& rows
   return j;
 }
 
+void readJson(const std::string& path, StudyMeta& meta, std::vector<CellResult>& rows) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "cannot open");
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    if (j.value("schema", "") != kJsonSchema || j.value("version", 0) != kJsonVersion)
+      throw InputError(path, "schema",
+                       "is not " + std::string(kJsonSchema) + " version " + std::to_string(kJsonVersion));
+    auto number = [](const nlohmann::json& v) { return v.is_number() ? v.get<double>() : kNaN; };
+    meta = StudyMeta();
+    meta.quick = j.at("quick").get<bool>();
+    meta.threads = j.at("threads").get<int>();
+    const nlohmann::json& machine = j.at("machine");
+    meta.cpu = machine.at("cpu").get<std::string>();
+    meta.hardwareThreads = machine.at("hardwareThreads").get<int>();
+    meta.memoryBytes = machine.at("memoryBytes").get<uint64_t>();
+    meta.loadStart = number(machine.at("loadAverage").at("start"));
+    meta.loadEnd = number(machine.at("loadAverage").at("end"));
+    meta.childMemoryLimit = j.at("childMemoryLimitBytes").get<uint64_t>();
+    meta.triangles = j.at("triangles").get<std::vector<uint64_t>>();
+    meta.sizes.clear();
+    for (const auto& s : j.at("sizes")) meta.sizes.push_back({s.at(0).get<int>(), s.at(1).get<int>()});
+    meta.seconds = j.at("seconds").get<double>();
+    rows.clear();
+    for (const auto& r : j.at("rows")) {
+      CellResult c;
+      c.triangles = r.at("triangles").get<uint64_t>();
+      c.width = r.at("width").get<int>();
+      c.height = r.at("height").get<int>();
+      c.renderer = r.at("renderer").get<std::string>();
+      c.status = r.at("status").get<std::string>();
+      c.detail = r.at("detail").get<std::string>();
+      c.runs = r.at("runs").get<int>();
+      const nlohmann::json& sec = r.at("seconds");
+      c.visibilitySeconds = number(sec.at("visibility"));
+      c.shadedSeconds = number(sec.at("shaded"));
+      c.bvhBuildSeconds = number(sec.at("bvhBuild"));
+      c.processSeconds = number(sec.at("process"));
+      const nlohmann::json& peak = r.at("peakRssBytes");
+      c.visibilityPeakRssBytes =
+          peak.at("visibility").is_number() ? peak.at("visibility").get<uint64_t>() : 0;
+      c.shadedPeakRssBytes = peak.at("shaded").is_number() ? peak.at("shaded").get<uint64_t>() : 0;
+      rows.push_back(c);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, "", std::string("not a crossover.json: ") + e.what());
+  }
+}
+
 std::vector<NamedPlot> crossoverPlots(const StudyMeta& meta, const std::vector<CellResult>& rows) {
   std::vector<NamedPlot> plots;
   for (const bool shaded : {true, false}) {
@@ -344,15 +393,24 @@ std::vector<NamedPlot> crossoverPlots(const StudyMeta& meta, const std::vector<C
     p.file = shaded ? "crossover-shaded.svg" : "crossover-visibility.svg";
     p.plot.title = std::string("Faster renderer: ") + (shaded ? "shaded frame" : "primary visibility") +
                    " (label: slower / faster time)";
-    p.plot.x = {"triangles", "", AxisScale::Log};
-    p.plot.y = {"image size", "pixels", AxisScale::Log};
+    // Fixed ranges half a decade (x) and a factor 2 (y) beyond the cells, so
+    // no marker or label sits on the frame.
+    uint64_t tMin = ~0ull, tMax = 0;
+    double pMin = 1e300, pMax = 0;
+    for (const uint64_t t : meta.triangles) tMin = std::min(tMin, t), tMax = std::max(tMax, t);
+    for (const ImageSize& s : meta.sizes) {
+      pMin = std::min(pMin, double(s.width) * double(s.height));
+      pMax = std::max(pMax, double(s.width) * double(s.height));
+    }
+    p.plot.x = {"triangles", "", AxisScale::Log, double(tMin) / 3.0, double(tMax) * 3.0};
+    p.plot.y = {"image size", "pixels", AxisScale::Log, pMin / 2.0, pMax * 2.0};
     PlotSeries raster{"rasterizer faster", {}, PlotLine::None};
     raster.colour = 0;
     raster.marker = 1;  // squares
     PlotSeries ray{"ray caster faster", {}, PlotLine::None};
     ray.colour = 1;
     ray.marker = 0;  // circles
-    PlotSeries none{"not measured (see table)", {}, PlotLine::None};
+    PlotSeries none{"only one or neither renderer ran", {}, PlotLine::None};
     none.colour = 6;
     none.marker = 5;  // crosses
     for (const uint64_t t : meta.triangles)
@@ -366,6 +424,11 @@ std::vector<NamedPlot> crossoverPlots(const StudyMeta& meta, const std::vector<C
                      (r.ok() ? num(shaded ? r.shadedSeconds : r.visibilitySeconds, "%.4g") + " s" : r.status);
         pt.tooltip = countText(t) + " triangles at " + sizeText(s.width, s.height) + times;
         if (w.renderer.empty()) {
+          // Which renderer did run, if one did (the other ran out of memory,
+          // timed out or was skipped: the tooltip says which).
+          for (const CellResult& r : rows)
+            if (r.triangles == t && r.width == s.width && r.height == s.height && r.ok())
+              pt.text = r.renderer == std::string("raster") ? "rasterizer only" : "ray caster only";
           none.points.push_back(pt);
           continue;
         }
@@ -382,8 +445,8 @@ std::vector<NamedPlot> crossoverPlots(const StudyMeta& meta, const std::vector<C
   for (const bool memory : {false, true}) {
     NamedPlot p;
     p.file = memory ? "crossover-memory.svg" : "crossover-time.svg";
-    p.plot.title =
-        memory ? "Peak memory of one render process" : "Time to a shaded frame (BVH build included)";
+    p.plot.title = memory ? "Peak memory of the process rendering a shaded frame"
+                          : "Time to a shaded frame (BVH build included)";
     p.plot.x = {"triangles", "", AxisScale::Log};
     p.plot.y = memory ? PlotAxis{"peak resident memory", "MiB", AxisScale::Log}
                       : PlotAxis{"time", "s", AxisScale::Log};
@@ -395,13 +458,23 @@ std::vector<NamedPlot> crossoverPlots(const StudyMeta& meta, const std::vector<C
                           {}};
         series.colour = renderer == std::string("raster") ? 0 : 1;
         series.marker = index++;
-        for (const CellResult& r : rows)
-          if (r.renderer == renderer && r.width == s.width && r.height == s.height && r.ok()) {
+        for (const CellResult& r : rows) {
+          if (r.renderer != renderer || r.width != s.width || r.height != s.height) continue;
+          if (r.ok()) {
             const double y = memory ? double(r.shadedPeakRssBytes) / (1024.0 * 1024.0) : r.shadedSeconds;
             series.points.push_back(
                 {double(r.triangles), y,
                  countText(r.triangles) + " triangles: " + num(y, "%.4g") + (memory ? " MiB" : " s"), ""});
+          } else if (memory && r.status == "out of memory") {
+            // What the process held when an allocation failed: a lower bound.
+            const double y = double(std::max(r.visibilityPeakRssBytes, r.shadedPeakRssBytes)) / 1048576.0;
+            if (y > 0)
+              series.points.push_back(
+                  {double(r.triangles), y,
+                   countText(r.triangles) + " triangles: out of memory after " + num(y, "%.0f") + " MiB",
+                   "out of memory (needs more)"});
           }
+        }
         p.plot.series.push_back(series);
       }
     plots.push_back(p);

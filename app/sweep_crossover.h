@@ -125,6 +125,10 @@ std::string toCsv(const std::vector<CellResult>& rows);
 //               "visibility": {"faster", "ratio"}, "shaded": {"faster", "ratio"}}]}
 // Unmeasured values are null.
 nlohmann::json toJson(const StudyMeta& meta, const std::vector<CellResult>& rows);
+// Reads crossover.json back (the rows and what they were measured on), e.g.
+// to write the report again; throws InputError (file: path) on another
+// schema or version or a malformed file.
+void readJson(const std::string& path, StudyMeta& meta, std::vector<CellResult>& rows);
 
 // The plots: where each renderer wins (x triangles, y pixels, both log; one
 // marker per cell in the faster renderer's series, labelled with the ratio)

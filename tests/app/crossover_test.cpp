@@ -18,6 +18,7 @@
 
 #include "app/render_setup.h"
 #include "app/sweep_crossover_scene.h"
+#include "common/error.h"
 #include "common/scene.h"
 #include "xml_check.h"
 
@@ -178,6 +179,18 @@ TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
     EXPECT_GE(w.at("shaded").at("ratio").get<double>(), 1.0);
   }
 
+  // The JSON reads back to the same rows and files.
+  StudyMeta readMeta;
+  std::vector<CellResult> readRows;
+  readJson((dir.path / "crossover.json").string(), readMeta, readRows);
+  EXPECT_EQ(toCsv(readRows), toCsv(rows));
+  EXPECT_EQ(toJson(readMeta, readRows), toJson(meta, rows));
+  {
+    std::ofstream bad(dir.path / "other.json");
+    bad << R"({"schema": "rastray.sweep", "version": 1})";
+  }
+  EXPECT_THROW(readJson((dir.path / "other.json").string(), readMeta, readRows), InputError);
+
   // Plots: valid XML, labelled axes, every cell placed (the winner maps).
   for (const char* file :
        {"crossover-shaded.svg", "crossover-visibility.svg", "crossover-time.svg", "crossover-memory.svg"}) {
@@ -240,6 +253,10 @@ TEST(Crossover, CellsThatCannotRunAreRecorded) {
   }
   writeCrossoverReport(options.reportDir, meta, rows);
   EXPECT_NE(readFile(dir.path / "crossover.csv").find("skipped"), std::string::npos);
+  // The winner map still places every cell, as "neither renderer ran".
+  const PlotRender map = renderPlot(crossoverPlots(meta, rows)[0].plot);
+  EXPECT_EQ(map.drawn, 4u);
+  EXPECT_EQ(map.skipped, 0u);
 
   options.rastray = "/nonexistent/rastray";
   options.childMemoryLimitBytes = 0;
