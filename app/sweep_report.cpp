@@ -39,6 +39,23 @@ std::string settingsText(const SweepMeta& meta, const CellResult& r) {
 
 double time(const CellResult& r) { return r.time.median; }
 
+// Whole decades around the positive values, at least a tenth of a decade
+// beyond the extreme points, so no point or label sits on the frame. Left
+// to the plot (NaN) when no value is positive.
+void decadeRange(const std::vector<PlotPoint>& points, bool x, PlotAxis& axis) {
+  double lo = HUGE_VAL, hi = 0;
+  for (const PlotPoint& p : points) {
+    const double v = x ? p.x : p.y;
+    if (v > 0 && std::isfinite(v)) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  }
+  if (hi <= 0) return;
+  axis.min = std::pow(10.0, std::floor(std::log10(lo) - 0.1));
+  axis.max = std::pow(10.0, std::ceil(std::log10(hi) + 0.1));
+}
+
 }  // namespace
 
 const std::vector<ErrorMetric>& errorMetrics() {
@@ -80,7 +97,8 @@ std::vector<SweepPlot> sweepPlots(const SweepMeta& meta, const std::vector<CellR
         PlotPoint p = all[i];
         const double lx = p.x > 0 ? std::log10(p.x) : -1e300, ly = p.y > 0 ? std::log10(p.y) : -1e300;
         if (std::fabs(lx - lastX) > 0.35 || std::fabs(ly - lastY) > 0.12) {
-          for (const std::string& v : cells[i]->values) p.text += (p.text.empty() ? "" : " ") + v;
+          for (const std::string& v : cells[i]->values)
+            if (v != "n/a") p.text += (p.text.empty() ? "" : " ") + v;
           lastX = lx;
           lastY = ly;
         }
@@ -93,6 +111,8 @@ std::vector<SweepPlot> sweepPlots(const SweepMeta& meta, const std::vector<CellR
         plot.title = baseName(scene) + ": " + metric.name + " against time";
         plot.x = {"render time (BVH build + frame, median)", "s", AxisScale::Log};
         plot.y = {metric.quantity, metric.unit, AxisScale::Log};
+        decadeRange(all, true, plot.x);
+        decadeRange(all, false, plot.y);
         std::string by = "cells";
         if (!vary.empty()) {
           by = vary[a].name;
