@@ -4,60 +4,19 @@
 // side with the mismatch class of each disagreement.
 #include "app/explain.h"
 
-#include <unistd.h>
-
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <memory>
-#include <sstream>
 
 #include "app/commands.h"
 #include "app/crossval.h"
 #include "common/error.h"
 #include "common/sampling.h"
+#include "common/trace.h"
 #include "compare/classify.h"
 
 namespace rastray {
 
 namespace {
-
-// The renderers write their per-pixel traces to stderr (they are debugging
-// aids first). To put them in one report, stderr is pointed at a temporary
-// file for the duration of one render.
-class StderrCapture {
- public:
-  StderrCapture() {
-    std::fflush(stderr);
-    path_ =
-        (std::filesystem::temp_directory_path() / ("rastray-explain-" + std::to_string(getpid()))).string();
-    saved_ = dup(STDERR_FILENO);
-    std::FILE* f = std::fopen(path_.c_str(), "w");
-    if (saved_ < 0 || !f) throw std::runtime_error("cannot capture the renderers' trace output");
-    dup2(fileno(f), STDERR_FILENO);
-    std::fclose(f);
-  }
-  ~StderrCapture() { restore(); }
-  std::string finish() {
-    restore();
-    std::ifstream in(path_);
-    std::stringstream s;
-    s << in.rdbuf();
-    std::remove(path_.c_str());
-    return s.str();
-  }
-
- private:
-  void restore() {
-    if (saved_ < 0) return;
-    std::fflush(stderr);
-    dup2(saved_, STDERR_FILENO);
-    close(saved_);
-    saved_ = -1;
-  }
-  std::string path_;
-  int saved_ = -1;
-};
 
 std::string hitText(const DeepSample* s) {
   if (!s) return "nothing";
@@ -79,22 +38,19 @@ std::vector<const DeepSample*> layersOf(const DeepImage& image, size_t p, uint32
 std::string explainPixel(const Scene& scene, const RenderSettings& settings, int x, int y) {
   RenderSettings s = settings;
   s.debugPixel = glm::ivec2(x, y);
-  s.raster.debugPixel = s.ray.debugPixel = s.debugPixel;
+  // Each renderer records what it did at the pixel into its own log.
+  TraceLog rasterLog, rayLog;
+  s.raster.trace = {&rasterLog, {x, y}};
+  s.ray.trace = {&rayLog, {x, y}};
   s.keepSamples = true;
 
   std::string out;
   char line[512];
-  // Renders with one renderer while its trace of the pixel is captured.
-  auto renderTraced = [&](RendererKind kind, std::string* trace) {
-    s.renderer = kind;
-    StderrCapture capture;
-    RenderRun run = renderScene(scene, s);
-    *trace = capture.finish();
-    return run;
-  };
-  std::string rasterTrace, rayTrace;
-  const RenderRun raster = renderTraced(RendererKind::Raster, &rasterTrace);
-  const RenderRun ray = renderTraced(RendererKind::Raytrace, &rayTrace);
+  s.renderer = RendererKind::Raster;
+  const RenderRun raster = renderScene(scene, s);
+  s.renderer = RendererKind::Raytrace;
+  const RenderRun ray = renderScene(scene, s);
+  const std::string rasterTrace = rasterLog.text(), rayTrace = rayTreeText(rayLog.events(), {x, y});
 
   std::snprintf(line, sizeof line, "pixel (%d, %d) of %s, %dx%d, %d spp\ncamera %s\n\n", x, y,
                 scene.path.c_str(), raster.camera.width, raster.camera.height, s.spp,
@@ -102,7 +58,8 @@ std::string explainPixel(const Scene& scene, const RenderSettings& settings, int
   out += line;
   if (scene.origin != glm::dvec3(0.0)) {
     // Traced ray origins below are in the rebased frame (--origin camera).
-    std::snprintf(line, sizeof line, "positions below are relative to the render origin (%.17g, %.17g, %.17g)\n\n",
+    std::snprintf(line, sizeof line,
+                  "positions below are relative to the render origin (%.17g, %.17g, %.17g)\n\n",
                   scene.origin.x, scene.origin.y, scene.origin.z);
     out += line;
   }

@@ -7,6 +7,7 @@
 
 #include "common/error.h"
 #include "common/sampling.h"
+#include "common/trace.h"
 
 namespace rastray {
 
@@ -238,11 +239,11 @@ void RenderSettings::finish() {
                                                {"nearest", TextureFilter::Nearest},
                                                {"bilinear", TextureFilter::Bilinear},
                                                {"trilinear", TextureFilter::Trilinear}});
-  renderOrigin =
-      pick<RenderOrigin>("--origin", origin, {{"camera", RenderOrigin::Camera}, {"world", RenderOrigin::World}});
-  ray.offset = pick<RayOffsetMethod>("--ray-offset", rayOffset,
-                                     {{"error-bound", RayOffsetMethod::ErrorBound},
-                                      {"float-ulps", RayOffsetMethod::FloatUlps}});
+  renderOrigin = pick<RenderOrigin>("--origin", origin,
+                                    {{"camera", RenderOrigin::Camera}, {"world", RenderOrigin::World}});
+  ray.offset = pick<RayOffsetMethod>(
+      "--ray-offset", rayOffset,
+      {{"error-bound", RayOffsetMethod::ErrorBound}, {"float-ulps", RayOffsetMethod::FloatUlps}});
   if (!debugPixelXY.empty()) debugPixel = glm::ivec2(debugPixelXY[0], debugPixelXY[1]);
 
   raster.spp = spp;
@@ -301,12 +302,10 @@ void RenderSettings::finish() {
   raster.shadingRate = pick<ShadingRate>("--shading-rate", shadingRate,
                                          {{"sample", ShadingRate::Sample}, {"pixel", ShadingRate::Pixel}});
   raster.shading = shading;
-  raster.debugPixel = debugPixel;
   raster.keepSamples = keepSamples;
 
   ray.spp = spp;
   ray.shading = shading;
-  ray.debugPixel = debugPixel;
   ray.keepSamples = keepSamples;
 
   // Options given where they do not apply are refused, not ignored; given
@@ -339,6 +338,14 @@ Scene loadSceneForRender(const std::string& path, const RenderSettings& settings
   return scene;
 }
 
+std::string rayTreeText(const std::vector<TraceEvent>& events, glm::ivec2 pixel) {
+  size_t rays = 0;
+  for (const TraceEvent& e : events) rays += e.stage == TraceStage::Ray;
+  if (rays == 0) return "";
+  return "ray tree of pixel (" + std::to_string(pixel.x) + ", " + std::to_string(pixel.y) +
+         "): " + std::to_string(rays) + " rays\n" + traceText(events);
+}
+
 RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
   RenderRun run;
   run.analysis = analyzeScene(scene);
@@ -350,6 +357,12 @@ RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
       (s.debugPixel->x < 0 || s.debugPixel->y < 0 || s.debugPixel->x >= run.camera.width ||
        s.debugPixel->y >= run.camera.height))
     badOption("--debug-pixel", "pixel lies outside the image");
+  // --debug-pixel without a caller's sink: the rasterizer records into this
+  // log, printed to stderr after the render (the libraries never print).
+  TraceLog rasterTrace;
+  if (s.debugPixel && !raster.trace.sink) raster.trace = {&rasterTrace, *s.debugPixel};
+  TraceLog rayTrace;  // the ray caster's ray tree, likewise (--renderer raytrace)
+  if (s.debugPixel && !ray.trace.sink) ray.trace = {&rayTrace, *s.debugPixel};
 
   const auto start = std::chrono::steady_clock::now();
   const auto secondsSince = [](std::chrono::steady_clock::time_point t) {
@@ -373,14 +386,18 @@ RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
       caster.bind(run.camera, ray);
       const bool traced = raster.shadows == ShadowMode::Rays;
       run.output = renderRaster(scene, run.analysis, run.camera, raster, &caster, traced ? &caster : nullptr);
+      caster.throwIfError();  // an Embree error in the rays the rasterizer's shading traced
       run.output.counters.merge(caster.counters());
       break;
     }
   }
   // The Embree scene (BVH) is built once per scene, whatever the camera:
   // reported apart so a sweep can tell it from the frame's own work.
-  if (bvhBuild >= 0.0) run.output.timings.insert(run.output.timings.begin(), {"raytrace.bvh_build", bvhBuild});
+  if (bvhBuild >= 0.0)
+    run.output.timings.insert(run.output.timings.begin(), {"raytrace.bvh_build", bvhBuild});
   run.seconds = secondsSince(start);
+  if (raster.trace.sink == &rasterTrace) std::fputs(rasterTrace.text().c_str(), stderr);
+  if (ray.trace.sink == &rayTrace) std::fputs(rayTreeText(rayTrace.events(), *s.debugPixel).c_str(), stderr);
   return run;
 }
 

@@ -17,6 +17,7 @@
 #include "common/gltf/loader.h"
 #include "common/render_output.h"
 #include "common/scene.h"
+#include "common/trace.h"
 #include "raster/rasterizer.h"
 #include "raytrace/ray_caster.h"
 
@@ -115,7 +116,14 @@ struct RenderRun {
 Scene loadSceneForRender(const std::string& path, const RenderSettings& settings);
 
 // Runs the chosen renderer; settings.finish() must have been called.
+// With settings.debugPixel, what the renderer recorded at that pixel is
+// printed to stderr afterwards, unless the caller gave the renderer's
+// options a trace sink of its own (explain).
 RenderRun renderScene(const Scene& scene, const RenderSettings& settings);
+
+// The ray caster's events of one pixel (TraceStage::Ray) as text under a
+// "ray tree of pixel (x, y): N rays" line; empty without ray events.
+std::string rayTreeText(const std::vector<TraceEvent>& events, glm::ivec2 pixel);
 
 nlohmann::json renderReportJson(const Scene& scene, const RenderSettings& settings, const RenderRun& run);
 void printRenderStats(const RenderRun& run);

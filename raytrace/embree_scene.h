@@ -1,6 +1,6 @@
 // The Embree device and scene built from the shared triangle store
-// (common/scene.h). Internal to raytrace/: the only place besides
-// ray_caster.cpp that includes Embree.
+// (common/scene.h). Internal to raytrace/: Embree is included here and by
+// the ray caster's parts (ray_caster_parts.h), nowhere else.
 //
 // IDs: one triangle geometry per instance, attached with geomID == instance
 // index, and the index buffer in triangle-ID order, so Embree's (geomID,

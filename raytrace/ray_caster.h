@@ -4,20 +4,34 @@
 // serves the rasterizer's shading through the SecondaryRayTracer and
 // LightVisibility interfaces of common/shading.h.
 //
+// Layout (ray_caster_parts.h is what the parts share):
+//   ray_caster.cpp          this class: binding, the report of passes,
+//                           counters, the traced pixel
+//   primary_visibility.cpp  primary rays: tiles, packets, flat and deep output
+//   radiance.cpp            the recursive radiance integrator: compositing a
+//                           ray's surfaces, reflection, refraction and shadow rays
+//   transparency.cpp        transparency continuation: filter callbacks, the
+//                           crossing rule and merge, a ray's surface list
+//   embree_scene.cpp        the Embree device and scene; ray_offset.cpp:
+//                           where secondary rays start
+//
 // Contract
 // - Primary rays: camera.primaryRay(pixel + sample position) over
 //   [tNear, tFar] (the near and far planes, as the rasterizer clips), in
 //   16×16-pixel tiles in parallel (TBB). Each hit is refined with
 //   refineHit() before shading, exactly as the rasterizer does, so both
-//   shade a shared (instance, triangle) from identical inputs. Z is the
-//   ray caster's own precision: Embree's float t × depthPerT of the
-//   front-most surface (the compare tool measures it); IDs are Embree's
+//   shade a shared (instance, triangle) from identical inputs. Two depths
+//   per surface, named apart in the code: the traversal depth (Embree's
+//   float t × depthPerT) and the plane depth (the double intersection with
+//   the triangle's plane × depthPerT, where it is shaded). Z is the
+//   traversal depth of the front-most surface, the ray caster's own
+//   precision (the compare tool measures it); IDs are Embree's
 //   (geomID, primID) = SPEC §1 (instance, triangle).
 // - Transparency continuation: filter callbacks collect every BLEND hit
 //   along the ray and reject it, so one traversal continues from the same t
 //   with no epsilon; opaque (and refractive, and covered MASK) hits are
 //   accepted and end it. The collected hits in front of the stopping one
-//   are deduplicated (below), ordered by (refined t, instance, triangle)
+//   are deduplicated (below), ordered by (plane t, instance, triangle)
 //   and composited front to back with premultiplied `over` until the first
 //   opaque surface or until the remaining transmittance 1 − α_acc is below
 //   RayOptions::transparencyCutoff (1e-4). MASK hits with alpha < cutoff
@@ -29,7 +43,7 @@
 //   triangles share a vertex position and lie on opposite sides of an edge
 //   through it seen along the ray (the ray went through their shared edge
 //   or vertex); the kept one is decided by an exact side test, as the
-//   rasterizer's top-left rule decides (CrossingRule in ray_caster.cpp).
+//   rasterizer's top-left rule decides (CrossingRule in transparency.cpp).
 //   Shadow rays follow the same rule, so a shared edge attenuates once.
 // - Culling (constructor): single-sided triangles seen from the culled side
 //   are rejected by a filter on those geometries, for every ray kind.
@@ -54,8 +68,8 @@
 //   ShadingOptions.
 // - Deep samples (keepSamples): for every sample, every surface its primary
 //   ray composited, front to back, each with its OWN unattenuated
-//   premultiplied colour (what Shader::shade returns for it), ending with
-//   the opaque one; compositing them with `over` per sample and box-
+//   premultiplied colour (what Shader::shade returns for it) and its
+//   traversal depth, ending with the opaque one; compositing them with `over` per sample and box-
 //   filtering the samples reproduces the flat pixel. Samples that hit
 //   nothing have no entries.
 // - Flat output: box filter of the samples' premultiplied colours; Z and
@@ -63,11 +77,20 @@
 //   nearest the pixel centre (centreSampleIndex).
 // - Counters: rays.primary, rays.shadow, rays.reflection, rays.refraction,
 //   rays.transparency, always all five, per thread and summed.
+// - Tracing: traceDebugPixel() re-traces one pixel with single rays and
+//   returns its ray tree (RayRecord, each ray before the rays its surfaces
+//   spawned); render() with RayOptions::trace records that tree into the
+//   sink as TraceStage::Ray events (rayTraceEvent). The trace context is
+//   passed down the recursion (the traced pixel gets a Shader of its own
+//   whose callbacks carry it): no globals, one pointer test per ray when
+//   nothing is traced, and traced rays are not counted.
+// - Never prints. Embree device errors are kept and raised as
+//   std::runtime_error("embree: ...") by render(), traceDebugPixel() and
+//   throwIfError().
 #pragma once
 
 #include <glm/glm.hpp>
 #include <memory>
-#include <optional>
 #include <vector>
 
 #include "common/analysis.h"
@@ -76,6 +99,7 @@
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "common/shading.h"
+#include "common/trace.h"
 
 namespace rastray {
 
@@ -99,11 +123,14 @@ struct RayOptions {
   // scalar reference path).
   bool packets = true;
   bool forcePackets = false;
-  int tileSize = 16;                     // pixels per side of a parallel work item
-  std::optional<glm::ivec2> debugPixel;  // print that pixel's ray tree to stderr
+  int tileSize = 16;  // pixels per side of a parallel work item
+  // render() records the ray tree of trace.pixel (TraceStage::Ray events,
+  // one per ray: rayTraceEvent) into trace.sink after the image.
+  TraceRequest trace;
 };
 
-// One traced ray of a pixel's ray tree (--debug-pixel and tests).
+// One traced ray of a pixel's ray tree (RayCaster::traceDebugPixel), in
+// tree order: each ray before the rays its surfaces spawned.
 struct RayRecord {
   RayKind kind = RayKind::Primary;
   int depth = 0;   // primary 0, each bounce +1; shadow rays: the depth of the ray whose hit they light
@@ -111,8 +138,10 @@ struct RayRecord {
   glm::dvec3 origin{0.0};
   glm::dvec3 direction{0.0};
   double tNear = 0.0, tFar = 0.0;
-  // The front-most surface the ray met (kNoId: none), its t, and how many
-  // surfaces it composited (transparent layers and the opaque one).
+  // The front-most surface the ray met (kNoId: none), its t (the plane t
+  // in double; shadow rays: Embree's float t of the first surface passed
+  // through), and how many surfaces it composited (transparent layers and
+  // the opaque one; shadow rays: passed through, 0 when blocked).
   uint32_t instance = kNoId, triangle = kNoId;
   double t = 0.0;
   int layers = 0;
@@ -121,6 +150,13 @@ struct RayRecord {
   // transmittance in rgb, alpha 1.
   glm::vec4 contribution{0.0f};
 };
+
+// A ray of the tree as a trace event (TraceStage::Ray): depth is the ray's
+// (shadow rays: the lit surface's + 1), outcome "hit" or "miss" (shadow
+// rays: "blocked", "unoccluded" or "through"), values kind, origin, dir,
+// tnear, tfar, t and layers (hits), surfaces (shadow rays passing
+// through), contribution or transmittance.
+TraceEvent rayTraceEvent(const RayRecord& record);
 
 class RayCaster : public SecondaryRayTracer, public LightVisibility {
  public:
@@ -149,10 +185,14 @@ class RayCaster : public SecondaryRayTracer, public LightVisibility {
   // does not need).
   CounterSet counters() const;
 
+  // Throws the first Embree error since the last check (render() and
+  // traceDebugPixel() check on their own; hybrid rendering calls this after
+  // the rasterizer is done with the interfaces above).
+  void throwIfError() const;
+
   // The ray tree of one pixel (all its samples), traced with single rays
   // exactly as render() traces them; does not touch the counters.
   std::vector<RayRecord> traceDebugPixel(glm::ivec2 pixel) const;
-  static void printRayTree(const std::vector<RayRecord>& records, glm::ivec2 pixel);
 
  private:
   struct Impl;

@@ -13,9 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "common/error.h"
 #include "common/gltf/loader.h"
 #include "common/sampling.h"
 #include "common/shading.h"
+#include "common/trace.h"
 #include "test_scenes.h"
 
 namespace rastray {
@@ -503,7 +505,76 @@ TEST(DebugPixel, RayTreeOfAGlassPixel) {
   for (int k = 0; k < 4; ++k) EXPECT_EQ(tree.front().contribution[k], c[k]);
   // The trace does not count rays.
   EXPECT_EQ(caster.counters().get("rays.primary"), 64u * 64u);
-  RayCaster::printRayTree(tree, pixel);
+
+  // render() with a trace request records the same tree into the sink, one
+  // Ray event per ray with its fields, and counts as before.
+  TraceLog log;
+  options.trace = {&log, pixel};
+  caster.bind(camera, options);
+  const RenderOutput traced = caster.render();
+  EXPECT_EQ(traced.counters.get("rays.primary"), 64u * 64u);
+  const std::vector<TraceEvent> events = log.events();
+  ASSERT_EQ(events.size(), tree.size());
+  for (size_t i = 0; i < tree.size(); ++i) {
+    const RayRecord& r = tree[i];
+    const TraceEvent& e = events[i];
+    EXPECT_EQ(e.stage, TraceStage::Ray);
+    EXPECT_EQ(e.sample, r.sample);
+    EXPECT_EQ(e.instance, r.instance);
+    EXPECT_EQ(e.triangle, r.triangle);
+    EXPECT_EQ(e.depth, r.kind == RayKind::Shadow ? r.depth + 1 : r.depth);
+    ASSERT_FALSE(e.values.empty());
+    EXPECT_EQ(e.values.front(), std::make_pair(std::string("kind"), std::string(toString(r.kind))));
+    if (r.kind != RayKind::Shadow) EXPECT_EQ(e.outcome, r.instance == kNoId ? "miss" : "hit");
+  }
+  EXPECT_EQ(events.front().outcome, "hit");
+  // A pixel outside the image is refused, not ignored.
+  options.trace = {&log, {64, 0}};
+  caster.bind(camera, options);
+  EXPECT_THROW(caster.render(), InputError);
+}
+
+// Each ray's record follows the ray whose surface spawned it: a shadow
+// ray's depth is the lit surface's, so it comes after a ray of that depth
+// and belongs to the same sample; every secondary ray follows a ray one
+// depth up.
+TEST(DebugPixel, RayTreeIsInTreeOrder) {
+  const Scene scene = loadScene(scenePath("cornell-box.gltf"));
+  const Camera camera = makeCamera(scene, {}, 32, 32);
+  RayCaster caster(scene, analyzeScene(scene));
+  RayOptions options;
+  options.spp = 4;
+  caster.bind(camera, options);
+  int shadows = 0, secondaries = 0;
+  for (int y = 0; y < 32; y += 5)
+    for (int x = 0; x < 32; x += 5) {
+      const std::vector<RayRecord> tree = caster.traceDebugPixel({x, y});
+      std::vector<int> open;  // depths of the non-shadow rays so far, per sample: a stack
+      int sample = -1;
+      for (const RayRecord& r : tree) {
+        if (r.kind == RayKind::Primary) {
+          EXPECT_EQ(r.sample, sample + 1);
+          sample = r.sample;
+          open = {0};
+          continue;
+        }
+        ASSERT_EQ(r.sample, sample);
+        ASSERT_FALSE(open.empty());
+        if (r.kind == RayKind::Shadow) {
+          ++shadows;
+          EXPECT_LE(r.depth, open.back());
+          continue;
+        }
+        ++secondaries;
+        while (!open.empty() && open.back() >= r.depth) open.pop_back();
+        ASSERT_FALSE(open.empty());
+        EXPECT_EQ(open.back(), r.depth - 1);
+        open.push_back(r.depth);
+      }
+      EXPECT_EQ(sample, 3);
+    }
+  EXPECT_GT(shadows, 0);
+  EXPECT_GT(secondaries, 0);
 }
 
 }  // namespace
@@ -544,8 +615,11 @@ TEST(SharedEdges, ARayThroughASharedEdgeCrossesTheSurfaceOnce) {
     if (std::getenv("RT_DEBUG") && diagonal != beside) {
       RayCaster caster(b.scene(), analyzeScene(b.scene()));
       caster.bind(makeCamera(b.scene(), {}, size, size), RayOptions{});
-      RayCaster::printRayTree(caster.traceDebugPixel({i, j}), {i, j});
-      RayCaster::printRayTree(caster.traceDebugPixel({i + 1, j}), {i + 1, j});
+      for (const glm::ivec2 p : {glm::ivec2(i, j), glm::ivec2(i + 1, j)}) {
+        std::vector<TraceEvent> events;
+        for (const RayRecord& r : caster.traceDebugPixel(p)) events.push_back(rayTraceEvent(r));
+        std::fprintf(stderr, "pixel (%d, %d)\n%s", p.x, p.y, traceText(events).c_str());
+      }
     }
     ++checked;
   }
