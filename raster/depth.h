@@ -32,7 +32,7 @@
 #include <cstdint>
 
 #include "common/depth_formula.h"
-#include "raster/rasterizer.h"
+#include "raster/options.h"
 
 namespace rastray {
 

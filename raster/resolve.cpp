@@ -4,10 +4,10 @@ namespace rastray {
 
 void resolveTile(const TileRect& rect, int spp, int centreSample, const TileSamples& samples,
                  FlatImage* image) {
-  const int w = rect.x1 - rect.x0;
+  const TileSampleIndex local{rect, spp};
   for (int y = rect.y0; y < rect.y1; ++y)
     for (int x = rect.x0; x < rect.x1; ++x) {
-      const size_t base = (size_t(y - rect.y0) * size_t(w) + size_t(x - rect.x0)) * size_t(spp);
+      const size_t base = local(x, y, 0);
       glm::vec4 sum(0.0f);
       for (int s = 0; s < spp; ++s) sum += samples.color[base + size_t(s)];
       const size_t p = image->index(x, y);

@@ -1,5 +1,8 @@
 #include "raster/setup.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -149,13 +152,6 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
   return (t->pixelMin.x > t->pixelMax.x || t->pixelMin.y > t->pixelMax.y) ? SetupOutcome::Offscreen
                                                                           : SetupOutcome::Ok;
 }
-
-}  // namespace rastray
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-namespace rastray {
 
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
                                             const SampleGrid& grid, const DepthSettings& depth, CullMode cull,

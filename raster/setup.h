@@ -38,7 +38,7 @@
 
 #include "common/scene.h"
 #include "raster/clip.h"
-#include "raster/rasterizer.h"
+#include "raster/options.h"
 
 namespace rastray {
 
@@ -112,10 +112,6 @@ enum class SetupOutcome { Ok, Degenerate, Culled, Offscreen };  // Offscreen: no
 // `cull`: which facing to drop (None keeps both).
 SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& depth,
                            const ClipVertex v[3], CullMode cull, TriangleSetup* out);
-
-}  // namespace rastray
-
-namespace rastray {
 
 struct SetupCounters {
   uint64_t trianglesIn = 0;

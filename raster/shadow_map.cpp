@@ -105,7 +105,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         DepthPassCounters dc;
         const TileRect rect = tiles.rect(tile);
         rasterDepthPass(setups, bins[size_t(tile)], grid, rect, kMapFormat, DepthFunc::Less, alphaTest,
-                        nullptr, &map.depth, &dc);
+                        TraceRequest{}, &map.depth, &dc);
         // Attenuating fragments in front of the opaque depth, kept per texel.
         CoverageScratch scratch;
         for (uint32_t index : transmissiveBins[size_t(tile)]) {

@@ -25,8 +25,8 @@
 #include "common/camera.h"
 #include "common/scene.h"
 #include "common/shading.h"
-#include "raster/raster.h"
-#include "raster/rasterizer.h"
+#include "raster/coverage.h"
+#include "raster/options.h"
 
 namespace rastray {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "common/image.h"
-#include "raster/raster.h"
+#include "raster/coverage.h"
 
 namespace rastray {
 

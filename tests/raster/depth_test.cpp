@@ -7,7 +7,7 @@
 #include <random>
 
 #include "raster/bin.h"
-#include "raster/raster.h"
+#include "raster/coverage.h"
 #include "raster/setup.h"
 #include "raster_test_util.h"
 
@@ -101,7 +101,7 @@ Prepared prepare(const Scene& scene, DepthFormat format, double factor, double u
 DepthTarget rasterize(const Prepared& p, std::vector<uint32_t> order, DepthFunc func, DepthFormat format) {
   DepthTarget target(32, 32, 4);
   DepthPassCounters n;
-  rasterDepthPass(p.setups, order, p.grid, TileRect{0, 0, 32, 32}, format, func, {}, nullptr, &target, &n);
+  rasterDepthPass(p.setups, order, p.grid, TileRect{0, 0, 32, 32}, format, func, {}, TraceRequest{}, &target, &n);
   return target;
 }
 

@@ -8,6 +8,7 @@
 #include "common/error.h"
 #include "common/gltf/loader.h"
 #include "common/sampling.h"
+#include "common/trace.h"
 #include "raster/rasterizer.h"
 #include "raster_test_util.h"
 
@@ -205,17 +206,83 @@ TEST(Wireframe, HiddenEdgesAreRemovedAndHalosGapCrossings) {
   EXPECT_GT(gapped, lines / 2);
 }
 
-TEST(DebugPixel, TracesEveryStageAtThePixel) {
+// The first event of `stage` at sample `sample` whose instance is
+// `instance` (kNoId: any), or nullptr.
+const TraceEvent* findEvent(const std::vector<TraceEvent>& events, TraceStage stage, int sample,
+                            uint32_t instance = kNoId) {
+  for (const TraceEvent& e : events)
+    if (e.stage == stage && e.sample == sample && (instance == kNoId || e.instance == instance)) return &e;
+  return nullptr;
+}
+
+std::string valueOf(const TraceEvent& e, const std::string& name) {
+  for (const auto& [n, v] : e.values)
+    if (n == name) return v;
+  return "";
+}
+
+TEST(TracePixel, RecordsEveryStageAtThePixelAndPrintsNothing) {
   const Scene scene = loadScene(test::scenePath("three-triangles.gltf"));
   const Camera camera = makeCamera(scene, CameraOverrides{}, 8, 8);
   RasterOptions o;
-  o.debugPixel = glm::ivec2(5, 5);  // on yellow's bottom edge, blue behind
+  TraceLog log;
+  o.trace = {&log, {5, 5}};  // on yellow's bottom edge, blue behind
   testing::internal::CaptureStderr();
+  const RenderOutput traced = test::render(scene, camera, o);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  const std::vector<TraceEvent> events = log.events();
+  const std::string text = log.text();
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.front().stage, TraceStage::Tile) << text;
+
+  // The fill rule: some sample lies exactly on an edge that is not top-left.
+  bool dropped = false;
+  for (const TraceEvent& e : events)
+    if (e.stage == TraceStage::Coverage)
+      for (const auto& [name, value] : e.values)
+        dropped = dropped || value.find("(on edge, dropped)") != std::string::npos;
+  EXPECT_TRUE(dropped) << text;
+
+  // Blue (instance 1) reaches the depth test at sample 0 with a hexadecimal key.
+  const TraceEvent* depth = findEvent(events, TraceStage::Depth, 0, 1);
+  ASSERT_NE(depth, nullptr) << text;
+  EXPECT_EQ(valueOf(*depth, "key").rfind("0x", 0), 0u) << text;
+  EXPECT_TRUE(depth->outcome == "pass" || depth->outcome == "fail") << text;
+
+  // The final colour of sample 0 is the pixel's colour (1 spp: the resolve is the identity).
+  const TraceEvent* final = findEvent(events, TraceStage::Final, 0);
+  ASSERT_NE(final, nullptr) << text;
+  const glm::vec4 c = traced.image.color[traced.image.index(5, 5)];
+  char expected[96];
+  std::snprintf(expected, sizeof expected, "(%.4f, %.4f, %.4f, %.4f)", double(c.r), double(c.g), double(c.b),
+                double(c.a));
+  EXPECT_EQ(valueOf(*final, "color"), expected);
+  EXPECT_NE(text.find("final sample 0:"), std::string::npos) << text;
+
+  // Tracing changes nothing in the image.
+  const RenderOutput plain = test::render(scene, camera, RasterOptions{});
+  EXPECT_EQ(plain.image.color, traced.image.color);
+  EXPECT_EQ(plain.image.depth, traced.image.depth);
+}
+
+TEST(TracePixel, OnlyTheTileHoldingThePixelRecords) {
+  const Scene scene = loadScene(test::scenePath("three-triangles.gltf"));
+  const Camera camera = makeCamera(scene, CameraOverrides{}, 160, 120);
+  RasterOptions o;
+  o.spp = 4;
+  TraceLog log;
+  o.trace = {&log, {100, 70}};
   test::render(scene, camera, o);
-  const std::string log = testing::internal::GetCapturedStderr();
-  EXPECT_NE(log.find("(on edge, dropped)"), std::string::npos) << log;
-  EXPECT_NE(log.find("depth  sample 0: instance 1"), std::string::npos) << log;
-  EXPECT_NE(log.find("final  sample 0"), std::string::npos) << log;
+  const std::vector<TraceEvent> events = log.events();
+  ASSERT_FALSE(events.empty());
+  int tiles = 0, finals = 0;
+  for (const TraceEvent& e : events) {
+    tiles += e.stage == TraceStage::Tile;
+    finals += e.stage == TraceStage::Final;
+  }
+  EXPECT_EQ(tiles, 1);
+  EXPECT_EQ(finals, 4);  // one per sample of the pixel
+  EXPECT_EQ(valueOf(events.front(), "rect"), "[64, 128) x [64, 120)");
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 #include "common/error.h"
 #include "raster/bin.h"
 #include "raster/clip.h"
-#include "raster/raster.h"
+#include "raster/coverage.h"
 #include "raster_test_util.h"
 
 namespace rastray {

@@ -1,5 +1,6 @@
-// Raster: per-sample coverage with the integer edge functions of setup.h
-// and the per-sample depth test.
+// Coverage and depth test: per-sample coverage with the integer edge
+// functions of setup.h, the per-sample depth keys and the depth test (the
+// stage between setup/binning and shading).
 //
 // Coverage is stepped incrementally: E at a pixel's corner plus a
 // per-sample constant a·ox + b·oy, all in exact int64 (setup.h proves the
@@ -9,10 +10,10 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstdio>
 #include <functional>
 #include <vector>
 
+#include "common/trace.h"
 #include "raster/bin.h"
 #include "raster/depth.h"
 #include "raster/setup.h"
@@ -102,15 +103,19 @@ inline uint32_t sampleDepthKey(const TriangleSetup& t, const SampleGrid& grid, D
 
 // Pass 1 of a tile: depth test and write for the setups in `bin` (OPAQUE and
 // MASK). `alphaTest`, when set, decides MASK coverage for a sample that
-// passed the depth test (true: covered). `debugPixel` (or nullptr) prints
-// every decision at that pixel to stderr.
+// passed the depth test (true: covered). `trace` (the caller passes an
+// empty request unless its pixel lies in `rect`) receives, at that pixel,
+// every triangle's setup and coverage (traceCoverage), each depth test
+// (key against the stored key and winner) and each MASK discard.
 void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
                      const SampleGrid& grid, const TileRect& rect, DepthFormat format, DepthFunc func,
                      const std::function<bool(const TriangleSetup&, int px, int py, int s)>& alphaTest,
-                     const glm::ivec2* debugPixel, DepthTarget* target, DepthPassCounters* counters);
+                     const TraceRequest& trace, DepthTarget* target, DepthPassCounters* counters);
 
-// Prints the edge values and fill-rule decisions of t at every sample of
-// pixel (px, py) (--debug-pixel).
-void traceCoverage(std::FILE* out, const TriangleSetup& t, const SampleGrid& grid, int px, int py);
+// Records t's setup (facing, snapped vertices and edge functions with their
+// fill-rule class, in fixed-point units of 1/unitsPerPixel pixel) and, at
+// every sample of pixel (px, py), the three edge values and whether the
+// fill rule covers it.
+void traceCoverage(TraceSink& sink, const TriangleSetup& t, const SampleGrid& grid, int px, int py);
 
 }  // namespace rastray

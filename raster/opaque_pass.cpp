@@ -1,0 +1,71 @@
+// Pass 1 of a tile: OPAQUE and MASK triangles with depth test and write
+// (coverage.h), then deferred shading: only the samples that won the depth
+// test are shaded, at the sample (--shading-rate sample) or once per pixel
+// and triangle with the pixel centre's footprint (--shading-rate pixel).
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+#include <utility>
+
+#include "raster/tile_renderer.h"
+
+namespace rastray {
+
+void TileRenderer::opaquePass(const TileRect& rect, const std::vector<uint32_t>& bin,
+                              const TraceRequest& trace, DepthTarget* target, ThreadCounters& n) const {
+  std::function<bool(const TriangleSetup&, int, int, int)> alphaTest;
+  if (analysis_.alphaTest)
+    alphaTest = [this](const TriangleSetup& t, int px, int py, int s) { return alphaCovered(t, px, py, s); };
+  rasterDepthPass(setups_, bin, grid_, rect, options_.depthFormat, options_.depthFunc, alphaTest, trace,
+                  target, &n.opaque);
+}
+
+TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,
+                                       const TraceRequest& trace, ThreadCounters& n) const {
+  const TileRect& rect = index.rect;
+  const int spp = grid_.spp;
+  TileSamples samples;
+  samples.color.assign(index.count(), glm::vec4(0.0f));
+  samples.front.assign(index.count(), SampleHit{});
+  std::vector<std::pair<uint64_t, glm::vec4>> pixelCache;  // shading rate pixel: one colour per triangle
+  for (int py = rect.y0; py < rect.y1; ++py)
+    for (int px = rect.x0; px < rect.x1; ++px) {
+      pixelCache.clear();
+      const glm::dvec2 corner(px, py);
+      for (int s = 0; s < spp; ++s) {
+        const uint32_t win = target.winners[target.index(px, py, s)];
+        if (win == kNoSetup) continue;
+        const TriangleSetup& t = setups_[win];
+        const uint32_t local = index(px, py, s);
+        const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
+        samples.front[local] = interpolatedHit(t, pos);
+        glm::vec4 c;
+        if (options_.shadingRate == ShadingRate::Pixel) {
+          auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
+                                 [&](const auto& e) { return e.first == t.id(); });
+          if (it != pixelCache.end()) {
+            c = it->second;
+          } else {
+            // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
+            c = shadeAt(t, pos, corner + glm::dvec2(0.5), n);
+            pixelCache.emplace_back(t.id(), c);
+          }
+        } else {
+          c = shadeAt(t, pos, pos, n);
+        }
+        samples.color[local] = c;
+        if (trace.sink && px == trace.pixel.x && py == trace.pixel.y) {
+          const SampleHit& h = samples.front[local];
+          char b[64];
+          std::snprintf(b, sizeof b, "(%.6f, %.6f)", double(h.b1), double(h.b2));
+          trace.sink->record(TraceEvent{TraceStage::Shade, s, t.instance, t.triangle, 1, "", {}}
+                                 .add("interpolated_depth", traceNumber(h.depth))
+                                 .add("b", b)
+                                 .add("color", traceColor(c)));
+        }
+      }
+    }
+  return samples;
+}
+
+}  // namespace rastray

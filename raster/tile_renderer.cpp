@@ -1,0 +1,122 @@
+// A tile's pipeline: pass 1 → deferred shading → pass 2 → compositing →
+// resolve (→ hits, deep samples), and the helpers every pass samples
+// triangles with.
+#include "raster/tile_renderer.h"
+
+#include <cmath>
+#include <string>
+
+#include "common/sampling.h"
+
+namespace rastray {
+
+ThreadCounters& ThreadCounters::operator+=(const ThreadCounters& other) {
+  opaque.coverageTests += other.opaque.coverageTests;
+  opaque.samplesTested += other.opaque.samplesTested;
+  opaque.samplesPassed += other.opaque.samplesPassed;
+  opaque.alphaRejected += other.opaque.alphaRejected;
+  blendCoverageTests += other.blendCoverageTests;
+  blendSamplesTested += other.blendSamplesTested;
+  fragmentsTransparent += other.fragmentsTransparent;
+  shadedSamples += other.shadedSamples;
+  peelPasses += other.peelPasses;
+  return *this;
+}
+
+TileRenderer::TileRenderer(const Scene& scene, const SceneAnalysis& analysis, const Camera& camera,
+                           const RasterOptions& options, const Shader& shader, const SampleGrid& grid,
+                           const std::vector<TriangleSetup>& setups)
+    : scene_(scene),
+      analysis_(analysis),
+      camera_(camera),
+      options_(options),
+      shader_(shader),
+      grid_(grid),
+      setups_(setups),
+      centre_(centreSampleIndex(options.spp)) {}
+
+void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarget* target,
+                          const TileOutputs& out, ThreadCounters& n) const {
+  const TileSampleIndex index{rect, grid_.spp};
+  // The one trace check of the tile: an empty request unless the traced
+  // pixel lies here.
+  const TraceRequest& asked = options_.trace;
+  const bool traced = asked.sink && asked.pixel.x >= rect.x0 && asked.pixel.x < rect.x1 &&
+                      asked.pixel.y >= rect.y0 && asked.pixel.y < rect.y1;
+  const TraceRequest trace = traced ? asked : TraceRequest{};
+  if (traced) {
+    trace.sink->record(TraceEvent{TraceStage::Tile, -1, kNoId, kNoId, 0, "", {}}
+                           .add("rect", "[" + std::to_string(rect.x0) + ", " + std::to_string(rect.x1) +
+                                            ") x [" + std::to_string(rect.y0) + ", " +
+                                            std::to_string(rect.y1) + ")")
+                           .add("opaque_mask_binned", std::to_string(bins.opaque.size()))
+                           .add("blend_binned", std::to_string(bins.blend ? bins.blend->size() : size_t(0))));
+  }
+
+  opaquePass(rect, bins.opaque, trace, target, n);
+  TileSamples samples = shadeVisible(index, *target, trace, n);
+  std::vector<BlendLayer> layers;
+  if (bins.blend && !bins.blend->empty()) layers = transparencyPass(index, *bins.blend, *target, n);
+  const std::vector<glm::vec4> opaqueColor = compositeLayers(layers, &samples);
+  if (traced) traceLayersAndFinal(index, trace, layers, samples);
+
+  resolveTile(rect, grid_.spp, centre_, samples, out.image);
+  if (out.hits) copyHits(index, samples, *target, out.hits);
+  if (out.deep)
+    appendDeepSamples(index, layers, *target, opaqueColor.empty() ? samples.color : opaqueColor, out);
+}
+
+SampleHit TileRenderer::interpolatedHit(const TriangleSetup& t, const glm::dvec2& pos) const {
+  const glm::dvec2 b = t.baryAt(pos.x, pos.y);
+  return {t.instance, t.triangle, float(t.viewDepthAt(pos.x, pos.y)), float(b.x), float(b.y)};
+}
+
+// The depth that orders BLEND layers: the view depth of the stored
+// triangle's plane along the primary ray (intersectTrianglePlane, double),
+// the key the ray caster sorts its layers by, so both renderers order
+// layers alike, and coincident duplicates tie exactly and fall back to
+// (instance, triangle). The interpolated depth when the plane is missed.
+double TileRenderer::planeDepth(const TriangleSetup& t, const glm::dvec2& pos) const {
+  const Ray ray = camera_.primaryRay(pos);
+  double th;
+  glm::dvec2 b;
+  if (intersectTrianglePlane(scene_, t.instance, t.triangle, ray, &th, &b) && th > 0.0) {
+    const double d = th * ray.depthPerT;
+    if (std::isfinite(d)) return d;
+  }
+  return t.viewDepthAt(pos.x, pos.y);
+}
+
+// The same inputs the ray caster shades from: the hit refined on the
+// stored triangle's plane along the primary ray through `pos`.
+SurfacePoint TileRenderer::surfaceAt(const TriangleSetup& t, const glm::dvec2& pos, Ray* ray) const {
+  *ray = camera_.primaryRay(pos);
+  return makeSurfacePoint(scene_, refineHit(scene_, *ray, interpolatedHit(t, pos)));
+}
+
+TextureFootprint TileRenderer::footprint(const SurfacePoint& p, const glm::dvec2& pos) const {
+  return analysis_.textures ? pixelFootprint(scene_, camera_, p, pos) : TextureFootprint{};
+}
+
+glm::vec4 TileRenderer::shadeAt(const TriangleSetup& t, const glm::dvec2& pos, const glm::dvec2& footprintPos,
+                                ThreadCounters& n) const {
+  Ray ray;
+  const SurfacePoint p = surfaceAt(t, pos, &ray);
+  ++n.shadedSamples;
+  return shader_.shade(p, ray.direction, footprint(p, footprintPos));
+}
+
+bool TileRenderer::alphaCovered(const TriangleSetup& t, int px, int py, int s) const {
+  const Material& m = scene_.materialOf(t.instance);
+  if (m.alphaMode != AlphaMode::Mask) return true;
+  const glm::dvec2 pos = glm::dvec2(px, py) + grid_.positions[size_t(s)];
+  Ray ray;
+  const SurfacePoint p = surfaceAt(t, pos, &ray);
+  return shader_.coverageAlpha(p, footprint(p, pos)) >= m.alphaCutoff;
+}
+
+glm::dvec2 TileRenderer::samplePosition(const TileSampleIndex& index, uint32_t local) const {
+  return glm::dvec2(index.pixel(local)) + grid_.positions[size_t(index.sample(local))];
+}
+
+}  // namespace rastray
