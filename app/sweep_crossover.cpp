@@ -530,8 +530,8 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
   ScratchDir scratch;
   std::vector<CellResult> rows;
   const size_t total = meta.triangles.size() * meta.sizes.size() * 2;
-  // Failed cells per renderer: a cell with at least as many triangles and
-  // pixels as one of them is skipped.
+  // Cells per renderer that ran out of memory or time: a cell with at least
+  // as many triangles and pixels as one of them is skipped.
   std::vector<std::pair<uint64_t, uint64_t>> failed[2];
   for (const uint64_t t : meta.triangles) {
     std::string lit, unlit;
@@ -587,7 +587,9 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
               r.processSeconds = shaded.summary.wall;
             }
           }
-          if (!r.ok()) failed[k].push_back({t, pixels});
+          // Only a cell that ran out of a resource says the larger ones will too.
+          if (r.status == "out of memory" || r.status == "killed" || r.status == "timeout")
+            failed[k].push_back({t, pixels});
         }
         rows.push_back(r);
         if (onCell) onCell(r, rows.size(), total);

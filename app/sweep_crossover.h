@@ -20,9 +20,10 @@
 // when a run takes under 5 s (--quick: 1 run), else of 1: other work on the
 // machine only ever adds time. A cell that runs out of memory (each
 // child's address space is limited to 85% of the memory available when the
-// study starts), is killed or times out is recorded as such; the larger
+// study starts), is killed or times out is recorded as such, and the larger
 // cells of that renderer (at least as many triangles and pixels) are then
-// skipped and recorded as skipped.
+// skipped and recorded as skipped; a cell that fails otherwise is recorded
+// as failed with the child's message.
 #pragma once
 
 #include <cstdint>

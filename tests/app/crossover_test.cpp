@@ -263,13 +263,12 @@ TEST(Crossover, CellsThatCannotRunAreRecorded) {
   const std::vector<CellResult> none = measureCells(options, meta, {});
   int failed = 0;
   for (const CellResult& r : none) {
-    EXPECT_TRUE(r.status == "failed" || r.status == "skipped") << r.status;
     if (r.status == "failed") {
       ++failed;
       EXPECT_NE(r.detail.find("could not run /nonexistent/rastray"), std::string::npos) << r.detail;
     }
   }
-  EXPECT_EQ(failed, 2);
+  EXPECT_EQ(failed, 8);  // a failure that is not for memory or time skips nothing
 }
 
 }  // namespace
