@@ -16,7 +16,14 @@ namespace rastray {
 struct SampleHit {
   uint32_t instance = kNoId;
   uint32_t triangle = kNoId;
-  float depth = std::numeric_limits<float>::infinity();  // view depth (SPEC §4), +inf: no hit
+  // View depth (SPEC §4), +inf: no hit; never a depth-buffer key. Which
+  // view depth depends on where the hit comes from: the rasterizer's
+  // interpolated depth (d/w ÷ 1/w at the sample, raster/tile_renderer.h),
+  // the ray caster's traversal depth (Embree's t · depthPerT), or, after
+  // refineHit (common/surface.h), the plane depth (the stored triangle's
+  // plane along the ray, in double). On one surface they differ only by
+  // rounding.
+  float depth = std::numeric_limits<float>::infinity();
   float b1 = 0.0f;
   float b2 = 0.0f;
 
