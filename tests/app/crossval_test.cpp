@@ -130,5 +130,25 @@ TEST(Explain, ShowsBothRenderersAndTheirHits) {
   EXPECT_EQ(runRastray({"explain", scene("three-triangles"), "80", "0", "--size", "80", "80"}).status, 2);
 }
 
+// --debug-pixel: the rasterizer records, the command prints the events to
+// stderr after the render; without it nothing reaches stderr.
+TEST(DebugPixel, RenderPrintsTheRasterTraceOnStderr) {
+  const std::string png =
+      (std::filesystem::temp_directory_path() / ("rastray-debug-pixel-" + std::to_string(getpid()) + ".png"))
+          .string();
+  const auto traced = runRastray({"render", scene("three-triangles"), "--size", "80", "80", "--spp", "4",
+                                  "--debug-pixel", "40", "40", "-o", png});
+  ASSERT_EQ(traced.status, 0) << traced.err;
+  EXPECT_EQ(traced.err.rfind("tile: rect [0, 64) x [0, 64)", 0), 0u) << traced.err;
+  EXPECT_NE(traced.err.find("  setup: edge 0 a "), std::string::npos) << traced.err;
+  EXPECT_NE(traced.err.find("  depth sample 0 instance 1 triangle 0: key 0x"), std::string::npos)
+      << traced.err;
+  EXPECT_NE(traced.err.find("  final sample 3: color ("), std::string::npos) << traced.err;
+  const auto plain = runRastray({"render", scene("three-triangles"), "--size", "80", "80", "-o", png});
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_EQ(plain.err, "");
+  std::filesystem::remove(png);
+}
+
 }  // namespace
 }  // namespace rastray
