@@ -18,6 +18,7 @@
 
 #include "app/commands.h"
 #include "app/sweep.h"
+#include "app/sweep_crossover.h"
 #include "app/sweep_report.h"
 #include "app/sweep_table.h"
 #include "common/error.h"
@@ -32,7 +33,8 @@ struct SweepOptions {
   std::string reference = "auto", reportDir, shard;
   int repeat = 3;
   bool resume = false;
-  RenderSettings settings;  // only to register the render options; read back as text
+  bool crossover = false, quick = false;  // the crossover study (app/sweep_crossover.h)
+  RenderSettings settings;                // only to register the render options; read back as text
   CLI::App* cmd = nullptr;
 };
 
@@ -211,6 +213,26 @@ int runSweep(const SweepOptions& opt) {
   return 0;
 }
 
+// `rastray sweep --crossover [--report DIR] [--quick] [--threads N]`: the
+// study renders its own generated scenes, so it takes no scene, --vary or
+// other render option.
+int runCrossoverStudy(const SweepOptions& opt) {
+  if (!opt.scenes.empty() || !opt.vary.empty() || !opt.merge.empty() || !opt.shard.empty() || opt.resume ||
+      opt.cmd->get_option("--reference")->count() || opt.cmd->get_option("--repeat")->count())
+    throw InputError("command line", "--crossover",
+                     "renders its own generated scenes: no SCENE, --vary, --reference, --repeat, --shard, "
+                     "--resume or --merge");
+  for (const std::string& arg : plainRenderArgs(opt))
+    if (arg.rfind("--", 0) == 0 && arg != "--threads")
+      throw InputError("command line", "--crossover",
+                       "takes no render option but --threads (" + arg + " given)");
+  crossover::CrossoverOptions o;
+  o.reportDir = opt.reportDir;
+  o.quick = opt.quick;
+  o.threads = opt.settings.threads;
+  return crossover::runCrossover(o);
+}
+
 }  // namespace
 
 CommandRunner addSweepCommand(CLI::App& app) {
@@ -231,14 +253,25 @@ CommandRunner addSweepCommand(CLI::App& app) {
   cmd->add_option("--repeat", opt->repeat, "Renders per cell (median and min-max of the time)")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  cmd->add_option("--report", opt->reportDir, "Folder for sweep.csv, sweep.json, index.html and plots/")
-      ->required();
+  cmd->add_option(
+      "--report", opt->reportDir,
+      "Folder for sweep.csv, sweep.json, index.html and plots/ (--crossover: default crossover-report)");
   cmd->add_option("--shard", opt->shard, "K/N: run only the cells whose number is K modulo N");
   cmd->add_flag("--resume", opt->resume, "Skip the cells already in the report folder's sweep.csv");
   cmd->add_option("--merge", opt->merge, "Shard report folders to join into --report (no scenes)");
+  cmd->add_flag(
+      "--crossover", opt->crossover,
+      "Instead: where the rasterizer and the ray caster cross over, on generated meshes of 1e2 to 1e7 "
+      "triangles at 320x240 to 3840x2160 (crossover.csv, crossover.json, plots)");
+  cmd->add_flag("--quick", opt->quick,
+                "With --crossover: at most 1e5 triangles and 640x480 (about a minute)");
   addRenderSettings(*cmd, opt->settings, /*withRenderer=*/true);
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return -1;
+    if (opt->crossover) return runCrossoverStudy(*opt);
+    if (opt->quick) throw InputError("command line", "--quick", "applies to --crossover only");
+    if (opt->reportDir.empty())
+      throw InputError("command line", "--report", "is required: the folder for the tables and plots");
     if (opt->merge.empty() && opt->scenes.empty())
       throw InputError("command line", "SCENE", "no scene given (or --merge DIR...)");
     if (opt->merge.empty() && opt->vary.empty())

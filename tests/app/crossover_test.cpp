@@ -20,6 +20,7 @@
 #include "app/sweep_crossover_scene.h"
 #include "common/error.h"
 #include "common/scene.h"
+#include "run_command.h"
 #include "xml_check.h"
 
 namespace rastray::crossover {
@@ -269,6 +270,25 @@ TEST(Crossover, CellsThatCannotRunAreRecorded) {
     }
   }
   EXPECT_EQ(failed, 8);  // a failure that is not for memory or time skips nothing
+}
+
+// The command: --crossover takes its own scenes and no render option but
+// --threads; --quick belongs to it (exit 2 with one line otherwise).
+TEST(Crossover, CommandRefusesWhatDoesNotApply) {
+  const std::string scene = std::string(RASTRAY_SCENES) + "/three-triangles.gltf";
+  const std::vector<std::vector<std::string>> refused = {
+      {"sweep", "--crossover", scene},
+      {"sweep", "--crossover", "--vary", "spp=1,4"},
+      {"sweep", "--crossover", "--spp", "4"},
+      {"sweep", "--crossover", "--renderer", "raster"},
+      {"sweep", "--crossover", "--repeat", "5"},
+      {"sweep", "--quick", scene, "--vary", "spp=1,4", "--report", "x"},
+  };
+  for (const auto& args : refused) {
+    const test::CommandResult r = test::runRastray(args);
+    EXPECT_EQ(r.status, 2) << args.back();
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
 }
 
 }  // namespace
