@@ -457,11 +457,14 @@ PlotRender renderPlot(const Plot& plot) {
         else
           s += m + "\n";
       }
-      if (!p.text.empty())
-        s += "<text x=\"" + num(px[i] + radius + 3) + "\" y=\"" + num(py[i] - radius - 2) +
-             "\" font-size=\"" + num(small) +
+      if (!p.text.empty()) {
+        // Right of the marker, or left of it when it would run past the plot area.
+        const bool toLeft = px[i] + radius + 3 + textWidth(p.text, small) > ax1;
+        s += "<text x=\"" + num(toLeft ? px[i] - radius - 3 : px[i] + radius + 3) + "\" y=\"" +
+             num(py[i] - radius - 2) + "\" font-size=\"" + num(small) + (toLeft ? "\" text-anchor=\"end" : "") +
              "\" fill=\"#222222\" stroke=\"#ffffff\" stroke-width=\"3\" paint-order=\"stroke\">" +
              escapeXml(p.text) + "</text>\n";
+      }
     }
     s += "</g>\n";
   }

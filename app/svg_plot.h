@@ -41,7 +41,8 @@ std::string axisTitle(const PlotAxis& axis);
 struct PlotPoint {
   double x = 0, y = 0;
   std::string tooltip;  // shown on hover (<title>); empty: none
-  std::string text;     // written beside the marker (e.g. "2.3x"); empty: none
+  std::string text;     // written beside the marker (e.g. "2.3x"), right of it unless it would
+                        // leave the plot area; empty: none
 };
 
 enum class PlotLine {

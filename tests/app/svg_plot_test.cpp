@@ -322,6 +322,30 @@ TEST(SvgPlot, StepLineAndTooltips) {
   EXPECT_EQ(tips, 2);  // hover targets even without markers
 }
 
+// A point's text stays inside the plot area: left of a marker near the right edge.
+TEST(SvgPlot, PointTextsStayInsideThePlotArea) {
+  Plot p;
+  p.x = {"x", ""};
+  p.y = {"y", ""};
+  p.series = {{"s", {{0, 0, "", "a long label at the left"}, {10, 10, "", "a long label at the right"}}}};
+  const PlotRender r = renderPlot(p);
+  std::string error;
+  int anchoredEnd = 0, texts = 0;
+  for (const test::Element& e : test::parseXml(r.svg, &error)) {
+    if (e.name != "text" || e.text.rfind("a long label", 0) != 0) continue;
+    ++texts;
+    const double x = std::stod(e.attributes.at("x"));
+    const bool end = e.attributes.count("text-anchor") && e.attributes.at("text-anchor") == "end";
+    anchoredEnd += end;
+    EXPECT_EQ(end, e.text == "a long label at the right");
+    EXPECT_GE(x, r.areaX);
+    EXPECT_LE(x, r.areaX + r.areaWidth);
+  }
+  EXPECT_TRUE(error.empty()) << error;
+  EXPECT_EQ(texts, 2);
+  EXPECT_EQ(anchoredEnd, 1);
+}
+
 TEST(SvgPlot, ParetoFrontKeepsTheUnbeatenPointsInOrder) {
   const double nan = std::nan("");
   const std::vector<PlotPoint> pts = {{5, 1}, {1, 9}, {2, 4}, {3, 5}, {2, 4}, {nan, 0}, {8, 0.5}, {1, 10}};
