@@ -11,6 +11,7 @@
 #include "common/analysis.h"
 #include "common/camera.h"
 #include "common/gltf/loader.h"
+#include "common/math_constants.h"
 #include "common/scene.h"
 
 namespace rastray {
@@ -104,7 +105,7 @@ int runInfo(const InfoOptions& opt) {
                    {"projection", toString(camera.projection)},
                    {"width", camera.width},
                    {"height", camera.height},
-                   {"yfovDegrees", camera.yfov * 180.0 / 3.14159265358979323846},
+                   {"yfovDegrees", camera.yfov * 180.0 / kPi},
                    {"aspect", camera.aspect},
                    {"xmag", camera.xmag},
                    {"ymag", camera.ymag},

@@ -31,6 +31,7 @@
 
 #include "app/stability.h"
 #include "app/stability_measure.h"
+#include "common/math_constants.h"
 
 namespace rastray::stability {
 
@@ -76,7 +77,7 @@ GltfMesh sphere(const glm::dvec3& centre, double radius, const glm::dvec3& offse
   constexpr int kSegments = 24, kRings = 12;
   for (int i = 0; i <= kRings; ++i)
     for (int j = 0; j <= kSegments; ++j) {
-      const double theta = M_PI * i / kRings, phi = 2.0 * M_PI * j / kSegments;
+      const double theta = kPi * i / kRings, phi = 2.0 * kPi * j / kSegments;
       const glm::dvec3 p = centre + radius * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta),
                                                         -std::sin(theta) * std::sin(phi));
       m.positions.push_back(glm::vec3(baked ? p + offset : p));

@@ -15,6 +15,7 @@
 #include "app/stability.h"
 #include "app/stability_measure.h"
 #include "common/hit.h"
+#include "common/math_constants.h"
 
 namespace rastray::stability {
 
@@ -229,7 +230,7 @@ GltfScene clipScene() {
   tri({-1e6f, -0.5f, 1e6f}, {1e6f, -0.5f, 1e6f}, {0.0f, -0.5f, -1e6f}, 1);  // 2e6 across the eye plane
   tri({3.0f, 0.3f, 0.0f}, {-0.6f, 0.05f, -1.0f}, {0.2f, 0.3f, -1.0f}, 2);   // a vertex at w = 0
   tri({0.0f, 0.0f, 0.0f}, {-2.0f, 0.5f, -4.0f}, {-1.0f, 1.5f, -4.0f}, 3);   // a vertex at the eye
-  GltfCamera c = lookDownZ(60.0 * 3.14159265358979323846 / 180.0);
+  GltfCamera c = lookDownZ(60.0 * kPi / 180.0);
   s.camera = c;
   return s;
 }

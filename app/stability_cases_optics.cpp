@@ -22,12 +22,11 @@
 
 #include "app/stability.h"
 #include "app/stability_measure.h"
+#include "common/math_constants.h"
 
 namespace rastray::stability {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // A UV sphere with smooth (analytic, unit) vertex normals, its pole on +Z
 // so a camera on the +Z axis looks straight at the pole vertex. `inward`:

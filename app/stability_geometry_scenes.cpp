@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/math_constants.h"
+
 namespace rastray::stability {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // splitmix64: a fixed, portable sequence (std:: distributions are not).
 class Rng {

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "common/error.h"
+#include "common/math_constants.h"
 #include "common/sampling.h"
 #include "compare/classify.h"
 #include "compare/maps.h"
@@ -183,7 +184,7 @@ ShadowCheck checkShadows(const Rendered& r, double tolerance) {
         }
         const double cosine = glm::dot(n, toLight);
         const glm::vec4& albedo = scene.materialOf(s.instance).baseColorFactor;
-        const double expected = irradiance * std::max(cosine, 0.0) / M_PI *
+        const double expected = irradiance * std::max(cosine, 0.0) / kPi *
                                 (double(albedo.r) * light.color.r + double(albedo.g) * light.color.g +
                                  double(albedo.b) * light.color.b);
         if (cosine < 0.1 || expected < 1e-3) {

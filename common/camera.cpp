@@ -7,12 +7,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "common/error.h"
+#include "common/math_constants.h"
 
 namespace rastray {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 [[noreturn]] void badOption(const std::string& option, const std::string& message) {
   throw InputError("command line", option, message);
@@ -89,7 +88,8 @@ std::string Camera::describe() const {
   else
     std::snprintf(buf, sizeof buf, "orthographic xmag %.6g ymag %.6g znear %.6g zfar %.6g", xmag, ymag, znear,
                   zfar);
-  return std::string(buf) + " eye " + fmt(eye() + worldOrigin) + " forward " + fmt(forward()) + " [" + origin + "]";
+  return std::string(buf) + " eye " + fmt(eye() + worldOrigin) + " forward " + fmt(forward()) + " [" +
+         origin + "]";
 }
 
 void applyRenderOrigin(Scene& scene, RenderOrigin mode, const CameraOverrides& overrides) {

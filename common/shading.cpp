@@ -3,13 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/math_constants.h"
 #include "common/optics.h"
 
 namespace rastray {
-
-namespace {
-constexpr double kInvPi = 0.31830988618379067154;
-}  // namespace
 
 const char* toString(RayKind kind) {
   switch (kind) {

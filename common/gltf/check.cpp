@@ -4,14 +4,13 @@
 #include <set>
 
 #include "common/error.h"
+#include "common/math_constants.h"
 
 namespace rastray {
 
 namespace {
 
 using json = nlohmann::json;
-
-constexpr double kPi = 3.14159265358979323846;
 
 // An accessor without a bufferView (zeros, or sparse over zeros) costs
 // memory but no file bytes; this bound keeps a hostile "count" from

@@ -5,11 +5,10 @@
 #include <gtest/gtest.h>
 
 #include "common/error.h"
+#include "common/math_constants.h"
 
 namespace rastray {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Scene boxScene(glm::dvec3 lo, glm::dvec3 hi) {
   Scene s;

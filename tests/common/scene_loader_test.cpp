@@ -14,6 +14,7 @@
 #include "common/camera.h"
 #include "common/error.h"
 #include "common/gltf/loader.h"
+#include "common/math_constants.h"
 #include "common/scene.h"
 
 // Readable failure messages for the GLM vectors compared below.
@@ -29,7 +30,6 @@ void PrintTo(const vec<N, T, Q>& v, std::ostream* os) {
 namespace rastray {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 const std::string kValid = std::string(RASTRAY_TEST_DATA) + "/malformed/valid/";
 const std::string kMalformed = std::string(RASTRAY_TEST_DATA) + "/malformed/";
 

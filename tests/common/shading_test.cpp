@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/math_constants.h"
+
 namespace rastray {
 namespace {
 
@@ -65,7 +67,7 @@ TEST(Shading, PointLightFollowsTheInverseSquareLaw) {
   const SurfacePoint p = centre(s);  // (0, -1/3, 0)
   const glm::dvec3 d = l.position - p.position;
   const double cosTheta = d.z / glm::length(d);
-  const double expected = 4.0 / glm::dot(d, d) * cosTheta / 3.14159265358979323846;
+  const double expected = 4.0 / glm::dot(d, d) * cosTheta / kPi;
   EXPECT_NEAR(shader.shade(p, {0, 0, -1}, {}).r, expected, 1e-6);
   // Seen from behind, the light on the front side does not reach the viewer's side.
   EXPECT_NEAR(shader.shade(p, {0, 0, 1}, {}).r, 0.0, 1e-9);

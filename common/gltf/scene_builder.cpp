@@ -1,0 +1,807 @@
+// Step 4 of loading (loader.cpp): the checked JSON and tinygltf's buffers
+// and images → the flattened Scene. Walks the node trees from the scene's
+// roots, flattens every triangle primitive into an instance with world-space
+// vertices, and reads materials, textures, the first camera and the lights.
+#include "common/gltf/scene_builder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <tiny_gltf.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <nlohmann/json.hpp>
+
+#include "common/error.h"
+#include "common/gltf/check.h"
+#include "common/gltf/document.h"
+#include "common/math_constants.h"
+
+namespace rastray {
+
+namespace {
+
+using json = nlohmann::json;
+
+class SceneBuilder {
+ public:
+  SceneBuilder(const std::string& path, const json& doc, const tinygltf::Model& model)
+      : path_(path), doc_(doc), model_(model) {}
+
+  Scene build();
+
+ private:
+  [[noreturn]] void fail(const std::string& element, const std::string& message) const {
+    throw InputError(path_, element, message);
+  }
+  const json& array(const char* key) const {
+    static const json empty = json::array();
+    auto it = doc_.find(key);
+    return it == doc_.end() ? empty : *it;
+  }
+  template <typename T>
+  T get(const json& obj, const char* key, T fallback) const {
+    auto it = obj.find(key);
+    return it == obj.end() ? fallback : it->get<T>();
+  }
+
+  glm::dmat4 localMatrix(size_t node) const;
+  void checkNodeGraph(std::vector<int64_t>& parent) const;
+  std::vector<size_t> rootNodes(const std::vector<int64_t>& parent);
+  void walk(const std::vector<size_t>& roots);
+  void addPrimitive(size_t node, size_t mesh, size_t primitive, const glm::dmat4& world);
+  // The steps of addPrimitive.
+  struct VertexData {
+    int64_t positionAccessor = -1;
+    size_t count = 0;                                   // vertices
+    std::vector<double> positions, normals, texcoords;  // object space; normals, texcoords may be empty
+    std::vector<glm::vec4> colors;                      // empty without COLOR_0
+  };
+  uint32_t materialOf(const json& prim);  // adds the default material when the primitive names none
+  int64_t texCoordSetOf(const json& prim) const;
+  VertexData readVertexData(const json& prim, const std::string& e, Instance& inst) const;
+  void appendVertices(Instance& inst, const VertexData& v, const glm::dmat4& world, const std::string& e);
+  void appendTriangles(Instance& inst, const json& prim, const std::string& e);
+  void addCamera(size_t node, const glm::dmat4& world);
+  void addLight(size_t node, const glm::dmat4& world);
+  void loadMaterials();
+  void loadTextures();
+  // Records one more occurrence of a feature nothing renders (Scene::ignored).
+  void noteIgnored(const std::string& feature, const std::string& unit);
+  void noteIgnoredFeatures();
+  void noteIgnoredExtensions(const json& value, std::vector<std::string>& path);
+  // The texture a textureInfo names, or -1 when its texture has no image
+  // we could decode (e.g. only a KTX2 source through an extension).
+  int32_t decodableTexture(const json& textureInfo);
+  std::vector<glm::vec4> readColors(const json& attributes, const std::string& element,
+                                    size_t vertexCount) const;
+
+  // Reads accessor `index` as doubles (components × count), applying
+  // normalisation and sparse substitution. Ranges were checked before.
+  std::vector<double> readAccessor(int64_t index, const std::string& element,
+                                   std::initializer_list<const char*> types, size_t* components) const;
+  std::vector<uint32_t> readIndices(int64_t index, const std::string& element) const;
+
+  const std::string& path_;
+  const json& doc_;
+  const tinygltf::Model& model_;
+  Scene scene_;
+  int64_t defaultMaterial_ = -1;
+};
+
+// Component read with glTF normalisation rules (glTF 2.0 §3.11).
+double readComponent(const uint8_t* p, int64_t componentType, bool normalized) {
+  switch (componentType) {
+    case 5120: {
+      int8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case 5121: {
+      uint8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? v / 255.0 : v;
+    }
+    case 5122: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case 5123: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0 : v;
+    }
+    case 5125: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return normalized ? v / 4294967295.0 : v;
+    }
+    case 5126: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    default:
+      return 0.0;
+  }
+}
+
+// Types and component types were checked (check.cpp), so both are > 0.
+size_t componentBytes(int64_t componentType) { return size_t(componentSize(componentType)); }
+size_t typeComponents(const std::string& type) { return size_t(componentCount(type)); }
+
+std::vector<double> SceneBuilder::readAccessor(int64_t index, const std::string& element,
+                                               std::initializer_list<const char*> types,
+                                               size_t* components) const {
+  const json& a = array("accessors")[size_t(index)];
+  const std::string ae = element + " (accessor " + std::to_string(index) + ")";
+  const std::string type = a.at("type").get<std::string>();
+  if (std::find_if(types.begin(), types.end(), [&](const char* t) { return type == t; }) == types.end())
+    fail(ae, "type " + type + " is not allowed here");
+  const int64_t componentType = a.at("componentType").get<int64_t>();
+  const bool normalized = get(a, "normalized", false);
+  const size_t count = a.at("count").get<size_t>();
+  const size_t n = typeComponents(type);
+  const size_t cbytes = componentBytes(componentType);
+  *components = n;
+  std::vector<double> out(count * n, 0.0);  // no bufferView: zeros (glTF)
+
+  auto readView = [&](int64_t view, size_t byteOffset, size_t stride, size_t elements,
+                      size_t elementComponents, int64_t ctype, bool norm, double* dst) {
+    const json& v = array("bufferViews")[size_t(view)];
+    const auto& data = model_.buffers[v.at("buffer").get<size_t>()].data;
+    const size_t base = get<size_t>(v, "byteOffset", 0) + byteOffset;
+    for (size_t e = 0; e < elements; ++e)
+      for (size_t c = 0; c < elementComponents; ++c)
+        dst[e * elementComponents + c] =
+            readComponent(data.data() + base + e * stride + c * componentBytes(ctype), ctype, norm);
+  };
+
+  if (a.contains("bufferView")) {
+    const int64_t view = a.at("bufferView").get<int64_t>();
+    const size_t stride = get<size_t>(array("bufferViews")[size_t(view)], "byteStride", 0);
+    readView(view, get<size_t>(a, "byteOffset", 0), stride ? stride : n * cbytes, count, n, componentType,
+             normalized, out.data());
+  }
+  if (a.contains("sparse")) {
+    const json& s = a.at("sparse");
+    const size_t sparseCount = s.at("count").get<size_t>();
+    const json& si = s.at("indices");
+    const json& sv = s.at("values");
+    std::vector<double> indices(sparseCount), values(sparseCount * n);
+    const int64_t ict = si.at("componentType").get<int64_t>();
+    readView(si.at("bufferView").get<int64_t>(), get<size_t>(si, "byteOffset", 0), componentBytes(ict),
+             sparseCount, 1, ict, false, indices.data());
+    readView(sv.at("bufferView").get<int64_t>(), get<size_t>(sv, "byteOffset", 0), n * cbytes, sparseCount, n,
+             componentType, normalized, values.data());
+    for (size_t k = 0; k < sparseCount; ++k) {
+      const double i = indices[k];
+      if (!(i < double(count)))
+        fail(ae, "sparse index " + std::to_string(uint64_t(i)) + " out of range (" + std::to_string(count) +
+                     " elements)");
+      std::copy_n(values.data() + k * n, n, out.data() + size_t(i) * n);
+    }
+  }
+  for (size_t i = 0; i < out.size(); ++i)
+    if (!std::isfinite(out[i]))
+      fail(ae, "element " + std::to_string(i / n) + " component " + std::to_string(i % n) + " is " +
+                   (std::isnan(out[i]) ? "NaN" : "infinite"));
+  return out;
+}
+
+std::vector<uint32_t> SceneBuilder::readIndices(int64_t index, const std::string& element) const {
+  const json& a = array("accessors")[size_t(index)];
+  const std::string ae = element + " (accessor " + std::to_string(index) + ")";
+  const int64_t ct = a.at("componentType").get<int64_t>();
+  if (ct != 5121 && ct != 5123 && ct != 5125)
+    fail(ae, "index componentType " + std::to_string(ct) + " must be 5121, 5123 or 5125");
+  if (get(a, "normalized", false)) fail(ae, "indices must not be normalized");
+  size_t components = 0;
+  const std::vector<double> values = readAccessor(index, element, {"SCALAR"}, &components);
+  std::vector<uint32_t> out(values.size());
+  for (size_t i = 0; i < values.size(); ++i) out[i] = uint32_t(values[i]);
+  return out;
+}
+
+glm::dmat4 SceneBuilder::localMatrix(size_t node) const {
+  const json& n = array("nodes")[node];
+  if (n.contains("matrix")) {
+    std::vector<double> m = n.at("matrix").get<std::vector<double>>();
+    return glm::make_mat4(m.data());  // glTF matrices are column-major, as GLM's
+  }
+  glm::dmat4 result(1.0);
+  if (n.contains("translation")) {
+    const auto t = n.at("translation").get<std::vector<double>>();
+    result = glm::translate(result, glm::dvec3(t[0], t[1], t[2]));
+  }
+  if (n.contains("rotation")) {
+    const auto r = n.at("rotation").get<std::vector<double>>();
+    glm::dquat q(r[3], r[0], r[1], r[2]);  // glTF stores (x, y, z, w)
+    const double length = glm::length(q);
+    if (!(length > 0.0)) fail("node " + std::to_string(node), "\"rotation\" is a zero quaternion");
+    result = result * glm::mat4_cast(q / length);  // exporters round: renormalise
+  }
+  if (n.contains("scale")) {
+    const auto s = n.at("scale").get<std::vector<double>>();
+    result = glm::scale(result, glm::dvec3(s[0], s[1], s[2]));
+  }
+  return result;
+}
+
+void SceneBuilder::checkNodeGraph(std::vector<int64_t>& parent) const {
+  const json& nodes = array("nodes");
+  parent.assign(nodes.size(), -1);
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (!nodes[i].contains("children")) continue;
+    for (const json& c : nodes[i].at("children")) {
+      const size_t child = c.get<size_t>();
+      if (child == i) fail("node " + std::to_string(i), "lists itself as a child (cycle)");
+      if (parent[child] >= 0)
+        fail("node " + std::to_string(child), "is a child of both node " + std::to_string(parent[child]) +
+                                                  " and node " + std::to_string(i) +
+                                                  " (glTF nodes form trees)");
+      parent[child] = int64_t(i);
+    }
+  }
+  // With one parent per node, a cycle is a parent chain that never ends:
+  // follow each chain, marking nodes by the walk that reached them.
+  std::vector<size_t> seenBy(nodes.size(), SIZE_MAX);
+  for (size_t start = 0; start < nodes.size(); ++start) {
+    size_t i = start;
+    while (parent[i] >= 0 && seenBy[i] == SIZE_MAX) {
+      seenBy[i] = start;
+      i = size_t(parent[i]);
+      if (seenBy[i] == start)
+        fail("node " + std::to_string(i), "is its own ancestor (cycle in the node graph)");
+    }
+  }
+}
+
+std::vector<size_t> SceneBuilder::rootNodes(const std::vector<int64_t>& parent) {
+  const json& scenes = array("scenes");
+  std::vector<size_t> roots;
+  if (scenes.empty()) {
+    // No scenes: every root node, in index order (SPEC §1).
+    scene_.stats.sceneIndex = -1;
+    for (size_t i = 0; i < parent.size(); ++i)
+      if (parent[i] < 0) roots.push_back(i);
+    return roots;
+  }
+  const size_t index = get<size_t>(doc_, "scene", 0);
+  scene_.stats.sceneIndex = int(index);
+  const json& s = scenes[index];
+  const std::string e = "scene " + std::to_string(index);
+  std::vector<bool> listed(parent.size(), false);
+  if (s.contains("nodes")) {
+    for (const json& n : s.at("nodes")) {
+      const size_t node = n.get<size_t>();
+      if (parent[node] >= 0)
+        fail(e, "node " + std::to_string(node) + " is not a root node (child of node " +
+                    std::to_string(parent[node]) + ")");
+      if (listed[node]) fail(e, "lists node " + std::to_string(node) + " twice");
+      listed[node] = true;
+      roots.push_back(node);
+    }
+  }
+  return roots;
+}
+
+void SceneBuilder::walk(const std::vector<size_t>& roots) {
+  // Depth-first, children in order, with an explicit stack: a deep
+  // hierarchy must not overflow the call stack.
+  struct Item {
+    size_t node;
+    glm::dmat4 parentWorld;
+  };
+  std::vector<Item> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
+  const json& nodes = array("nodes");
+  while (!stack.empty()) {
+    const Item item = stack.back();
+    stack.pop_back();
+    const json& n = nodes[item.node];
+    const glm::dmat4 world = item.parentWorld * localMatrix(item.node);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!std::isfinite(world[c][r]))
+          fail("node " + std::to_string(item.node), "world matrix is not finite");
+    ++scene_.stats.visitedNodes;
+    if (n.contains("mesh")) {
+      const size_t mesh = n.at("mesh").get<size_t>();
+      const json& prims = array("meshes")[mesh].at("primitives");
+      for (size_t p = 0; p < prims.size(); ++p) {
+        const int64_t mode = get<int64_t>(prims[p], "mode", 4);
+        if (mode < 4) {
+          ++scene_.stats.skippedPrimitives;  // points and lines: no instance number
+          continue;
+        }
+        addPrimitive(item.node, mesh, p, world);
+      }
+    }
+    if (n.contains("camera")) addCamera(item.node, world);
+    if (n.contains("extensions") && n.at("extensions").contains("KHR_lights_punctual"))
+      addLight(item.node, world);
+    if (n.contains("children")) {
+      const json& children = n.at("children");
+      for (auto it = children.rbegin(); it != children.rend(); ++it)
+        stack.push_back({it->get<size_t>(), world});
+    }
+  }
+}
+
+void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, const glm::dmat4& world) {
+  const json& prim = array("meshes")[mesh].at("primitives")[primitive];
+  const std::string e = "mesh " + std::to_string(mesh) + " primitive " + std::to_string(primitive);
+  const json& attributes = prim.at("attributes");
+
+  if (scene_.instances.size() >= kNoId - 1) fail(e, "too many instances");
+  Instance inst;
+  inst.node = uint32_t(node);
+  inst.mesh = uint32_t(mesh);
+  inst.primitive = uint32_t(primitive);
+  inst.mode = int(get<int64_t>(prim, "mode", 4));
+  inst.worldFromObject = world;
+  inst.mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+  inst.material = materialOf(prim);
+  inst.firstVertex = uint32_t(scene_.positions.size());
+  inst.firstTriangle = uint32_t(scene_.triangles.size());
+
+  // No POSITION: the primitive keeps its instance number and draws nothing.
+  if (!attributes.contains("POSITION")) {
+    scene_.instances.push_back(inst);
+    return;
+  }
+  const VertexData vertices = readVertexData(prim, e, inst);
+  appendVertices(inst, vertices, world, e);
+  appendTriangles(inst, prim, e);
+  scene_.instances.push_back(inst);
+}
+
+uint32_t SceneBuilder::materialOf(const json& prim) {
+  if (prim.contains("material")) return prim.at("material").get<uint32_t>();
+  if (defaultMaterial_ < 0) {
+    Material m;
+    m.name = "default";
+    m.isDefault = true;
+    defaultMaterial_ = int64_t(scene_.materials.size());
+    scene_.materials.push_back(m);
+  }
+  return uint32_t(defaultMaterial_);
+}
+
+// The texcoord set the base colour texture reads (TEXCOORD_0 unless it
+// says otherwise); without one, the emissive texture's set. loadMaterials
+// drops an emissive texture that names another set than the base colour.
+int64_t SceneBuilder::texCoordSetOf(const json& prim) const {
+  if (!prim.contains("material")) return 0;
+  const json& m = array("materials")[prim.at("material").get<size_t>()];
+  if (m.contains("pbrMetallicRoughness") && m.at("pbrMetallicRoughness").contains("baseColorTexture"))
+    return get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0);
+  if (m.contains("emissiveTexture")) return get<int64_t>(m.at("emissiveTexture"), "texCoord", 0);
+  return 0;
+}
+
+SceneBuilder::VertexData SceneBuilder::readVertexData(const json& prim, const std::string& e,
+                                                      Instance& inst) const {
+  const json& attributes = prim.at("attributes");
+  VertexData v;
+  size_t components = 0;
+  v.positionAccessor = attributes.at("POSITION").get<int64_t>();
+  v.positions = readAccessor(v.positionAccessor, e + " POSITION", {"VEC3"}, &components);
+  v.count = v.positions.size() / 3;
+  if (scene_.positions.size() + v.count >= size_t(kNoId)) fail(e, "the scene has more than 2^32 vertices");
+
+  if (attributes.contains("NORMAL")) {
+    v.normals = readAccessor(attributes.at("NORMAL").get<int64_t>(), e + " NORMAL", {"VEC3"}, &components);
+    if (v.normals.size() != v.positions.size())
+      fail(e, "NORMAL has " + std::to_string(v.normals.size() / 3) + " elements, POSITION " +
+                  std::to_string(v.count));
+    inst.normals = NormalSource::Authored;
+  }
+  const std::string uvName = "TEXCOORD_" + std::to_string(texCoordSetOf(prim));
+  if (attributes.contains(uvName)) {
+    v.texcoords = readAccessor(attributes.at(uvName).get<int64_t>(), e + " " + uvName, {"VEC2"}, &components);
+    if (v.texcoords.size() / 2 != v.count)
+      fail(e, uvName + " has " + std::to_string(v.texcoords.size() / 2) + " elements, POSITION " +
+                  std::to_string(v.count));
+    inst.hasTexcoords = true;
+  }
+  v.colors = readColors(attributes, e, v.count);
+  inst.hasColors = !v.colors.empty();
+  return v;
+}
+
+void SceneBuilder::appendVertices(Instance& inst, const VertexData& v, const glm::dmat4& world,
+                                  const std::string& e) {
+  // Scene::colors stays empty until an instance has COLOR_0; then it is
+  // back-filled with white for the vertices before it.
+  if (inst.hasColors && scene_.colors.empty()) scene_.colors.assign(scene_.positions.size(), glm::vec4(1.0f));
+
+  // Normals transform by the cofactor matrix: the inverse transpose scaled
+  // by the determinant, defined even for singular matrices; the sign keeps
+  // normals on the same side for mirroring transforms.
+  const glm::dmat3 m3(world);
+  const glm::dmat3 cofactor(glm::cross(m3[1], m3[2]), glm::cross(m3[2], m3[0]), glm::cross(m3[0], m3[1]));
+  const double sign = inst.mirrored ? -1.0 : 1.0;
+  const std::vector<double>& pos = v.positions;
+  const std::vector<double>& nrm = v.normals;
+  const std::vector<double>& uv = v.texcoords;
+  for (size_t i = 0; i < v.count; ++i) {
+    const glm::dvec3 p = glm::dvec3(world * glm::dvec4(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2], 1.0));
+    // Test in double: converting a value beyond the float range is undefined.
+    constexpr double kFloatMax = std::numeric_limits<float>::max();
+    if (!(std::abs(p.x) <= kFloatMax && std::abs(p.y) <= kFloatMax && std::abs(p.z) <= kFloatMax))
+      fail(e + " POSITION (accessor " + std::to_string(v.positionAccessor) + ")",
+           "vertex " + std::to_string(i) + " is not finite in world space as float");
+    const glm::vec3 pf(p);
+    scene_.worldPositions.push_back(p);
+    scene_.positions.push_back(pf);
+    scene_.bounds.extend(glm::dvec3(pf));
+    glm::dvec3 n(0.0);
+    if (!nrm.empty()) {
+      n = sign * (cofactor * glm::dvec3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]));
+      const double len = glm::length(n);
+      n = len > 0.0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);  // zero: use the face normal
+    }
+    scene_.normals.emplace_back(n);
+    scene_.texcoords.emplace_back(uv.empty() ? glm::vec2(0.0f)
+                                             : glm::vec2(float(uv[2 * i]), float(uv[2 * i + 1])));
+    if (inst.hasColors || !scene_.colors.empty())
+      scene_.colors.push_back(inst.hasColors ? v.colors[i] : glm::vec4(1.0f));
+  }
+  inst.vertexCount = uint32_t(v.count);
+}
+
+// Triangulates (SPEC §1) the primitive's indices, or its vertices in order
+// when it has none, into Scene::triangles.
+void SceneBuilder::appendTriangles(Instance& inst, const json& prim, const std::string& e) {
+  const size_t vertexCount = inst.vertexCount;
+  std::vector<uint32_t> indices;
+  if (prim.contains("indices")) {
+    const int64_t ia = prim.at("indices").get<int64_t>();
+    indices = readIndices(ia, e + " indices");
+    for (uint32_t i : indices)
+      if (i >= vertexCount)
+        fail("accessor " + std::to_string(ia),
+             "index " + std::to_string(i) + " out of range (" + std::to_string(vertexCount) + " vertices)");
+  } else {
+    indices.resize(vertexCount);
+    for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
+  }
+  const size_t n = indices.size();
+  std::vector<glm::uvec3> tris;
+  if (inst.mode == 4) {
+    if (n % 3 != 0)
+      fail(e, std::to_string(n) + (prim.contains("indices") ? " indices" : " vertices") +
+                  " for TRIANGLES is not a multiple of 3");
+    for (size_t i = 0; i + 2 < n; i += 3) tris.emplace_back(indices[i], indices[i + 1], indices[i + 2]);
+  } else if (inst.mode == 5) {
+    for (size_t i = 0; i + 2 < n; ++i)
+      tris.push_back(i % 2 == 0 ? glm::uvec3(indices[i], indices[i + 1], indices[i + 2])
+                                : glm::uvec3(indices[i + 1], indices[i], indices[i + 2]));
+  } else {
+    for (size_t i = 0; i + 2 < n; ++i) tris.emplace_back(indices[0], indices[i + 1], indices[i + 2]);
+  }
+  if (scene_.triangles.size() + tris.size() >= size_t(kNoId))
+    fail(e, "the scene has more than 2^32 triangles");
+  for (glm::uvec3 t : tris) {
+    if (inst.mirrored) std::swap(t.y, t.z);  // keep CCW = front in world space
+    t += glm::uvec3(inst.firstVertex);
+    scene_.triangles.push_back(t);
+    if (isDegenerate(scene_, scene_.triangles.size() - 1)) ++inst.degenerateCount;
+  }
+  inst.triangleCount = uint32_t(tris.size());
+}
+
+void SceneBuilder::addCamera(size_t node, const glm::dmat4& world) {
+  ++scene_.stats.cameraNodes;
+  if (scene_.camera) return;  // the first camera node in walk order wins (SPEC §2)
+  const size_t index = array("nodes")[node].at("camera").get<size_t>();
+  const json& c = array("cameras")[index];
+  const std::string e = "node " + std::to_string(node);
+  if (glm::length(glm::cross(glm::dvec3(world[0]), glm::dvec3(world[1]))) == 0.0 ||
+      glm::length(glm::dvec3(world[2])) == 0.0)
+    fail(e, "the camera's world matrix is singular");
+  CameraModel cam;
+  cam.worldFromCamera = world;
+  if (c.at("type") == "perspective") {
+    const json& p = c.at("perspective");
+    cam.projection = Projection::Perspective;
+    cam.yfov = p.at("yfov").get<double>();
+    cam.znear = p.at("znear").get<double>();
+    cam.zfar = get(p, "zfar", std::numeric_limits<double>::infinity());
+    cam.aspectRatio = get(p, "aspectRatio", 0.0);
+  } else {
+    const json& o = c.at("orthographic");
+    cam.projection = Projection::Orthographic;
+    cam.xmag = std::abs(o.at("xmag").get<double>());
+    cam.ymag = std::abs(o.at("ymag").get<double>());
+    cam.znear = o.at("znear").get<double>();
+    cam.zfar = o.at("zfar").get<double>();
+  }
+  const std::string name = get<std::string>(array("nodes")[node], "name", "");
+  cam.origin = "node " + std::to_string(node) + (name.empty() ? "" : " '" + name + "'") + " (camera " +
+               std::to_string(index) + ")";
+  scene_.camera = cam;
+}
+
+void SceneBuilder::addLight(size_t node, const glm::dmat4& world) {
+  const size_t index =
+      array("nodes")[node].at("extensions").at("KHR_lights_punctual").at("light").get<size_t>();
+  const json& l = doc_.at("extensions").at("KHR_lights_punctual").at("lights")[index];
+  Light light;
+  light.name = get<std::string>(l, "name", "");
+  const std::string type = l.at("type").get<std::string>();
+  light.type = type == "point" ? LightType::Point : type == "spot" ? LightType::Spot : LightType::Directional;
+  if (l.contains("color")) {
+    const auto c = l.at("color").get<std::vector<double>>();
+    if (c[0] < 0 || c[1] < 0 || c[2] < 0)
+      fail("light " + std::to_string(index), "\"color\" must not be negative");
+    light.color = glm::vec3(float(c[0]), float(c[1]), float(c[2]));
+  }
+  light.intensity = float(get(l, "intensity", 1.0));
+  light.range = float(get(l, "range", 0.0));
+  if (l.contains("spot")) {
+    light.innerConeAngle = float(get(l.at("spot"), "innerConeAngle", 0.0));
+    light.outerConeAngle = float(get(l.at("spot"), "outerConeAngle", kPi / 4));
+  }
+  light.position = glm::dvec3(world[3]);
+  const glm::dvec3 d = glm::dvec3(world * glm::dvec4(0.0, 0.0, -1.0, 0.0));
+  if (light.type != LightType::Point) {
+    if (!(glm::length(d) > 0.0)) fail("node " + std::to_string(node), "the light's world matrix is singular");
+    light.direction = glm::normalize(d);
+  }
+  light.node = uint32_t(node);
+  scene_.lights.push_back(light);
+}
+
+void SceneBuilder::loadTextures() {
+  // Images: tinygltf decoded them (stb); we keep RGBA8.
+  for (size_t i = 0; i < model_.images.size(); ++i) {
+    const tinygltf::Image& src = model_.images[i];
+    TextureImage img;
+    img.name = src.name;
+    img.width = src.width;
+    img.height = src.height;
+    const int comps = src.component;
+    const int bytes = src.bits / 8;
+    const size_t pixels = size_t(std::max(src.width, 0)) * size_t(std::max(src.height, 0));
+    if (src.width <= 0 || src.height <= 0 || comps < 1 || comps > 4 || (bytes != 1 && bytes != 2) ||
+        src.image.size() < pixels * size_t(comps * bytes))
+      fail("image " + std::to_string(i), src.image.empty() && !src.uri.empty()
+                                             ? "\"" + shortened(src.uri) + "\" could not be read"
+                                             : "could not be decoded to 8- or 16-bit pixels");
+    img.rgba8.resize(pixels * 4);
+    for (size_t p = 0; p < pixels; ++p) {
+      uint8_t c[4] = {0, 0, 0, 255};
+      for (int k = 0; k < comps; ++k) {
+        const size_t at = (p * size_t(comps) + size_t(k)) * size_t(bytes);
+        // 16-bit: keep the high byte, rounded (65535 → 255).
+        c[k] = bytes == 1
+                   ? src.image[at]
+                   : uint8_t((uint32_t(src.image[at]) | uint32_t(src.image[at + 1]) << 8) * 255u / 65535u);
+      }
+      if (comps == 1) c[1] = c[2] = c[0];  // grey
+      if (comps == 2) {
+        c[3] = c[1];
+        c[1] = c[2] = c[0];
+      }  // grey + alpha
+      std::memcpy(&img.rgba8[p * 4], c, 4);
+    }
+    scene_.images.push_back(std::move(img));
+  }
+  const json& textures = array("textures");
+  for (size_t i = 0; i < textures.size(); ++i) {
+    Texture t;
+    t.image = int32_t(get<int64_t>(textures[i], "source", -1));
+    if (textures[i].contains("sampler")) {
+      const json& s = array("samplers")[textures[i].at("sampler").get<size_t>()];
+      t.sampler.magFilter = int(get<int64_t>(s, "magFilter", -1));
+      t.sampler.minFilter = int(get<int64_t>(s, "minFilter", -1));
+      t.sampler.wrapS = int(get<int64_t>(s, "wrapS", 10497));
+      t.sampler.wrapT = int(get<int64_t>(s, "wrapT", 10497));
+    }
+    scene_.textures.push_back(t);
+  }
+}
+
+void SceneBuilder::loadMaterials() {
+  const json& materials = array("materials");
+  for (size_t i = 0; i < materials.size(); ++i) {
+    const json& m = materials[i];
+    const std::string e = "material " + std::to_string(i);
+    Material mat;
+    mat.name = get<std::string>(m, "name", "");
+    auto unit = [&](double v, const char* what) {
+      if (!(v >= 0.0 && v <= 1.0))
+        fail(e, std::string(what) + " " + std::to_string(v) + " must lie in [0, 1]");
+      return float(v);
+    };
+    if (m.contains("pbrMetallicRoughness")) {
+      const json& pbr = m.at("pbrMetallicRoughness");
+      if (pbr.contains("baseColorFactor")) {
+        const auto f = pbr.at("baseColorFactor").get<std::vector<double>>();
+        mat.baseColorFactor = glm::vec4(unit(f[0], "baseColorFactor"), unit(f[1], "baseColorFactor"),
+                                        unit(f[2], "baseColorFactor"), unit(f[3], "baseColorFactor"));
+      }
+      // A texture without an image we can decode is ignored (and listed):
+      // the factor alone applies.
+      if (pbr.contains("baseColorTexture"))
+        mat.baseColorTexture = decodableTexture(pbr.at("baseColorTexture"));
+      mat.metallic = unit(get(pbr, "metallicFactor", 1.0), "metallicFactor");
+      mat.roughness = unit(get(pbr, "roughnessFactor", 1.0), "roughnessFactor");
+    }
+    glm::dvec3 emissive(0.0);
+    if (m.contains("emissiveFactor")) {
+      const auto f = m.at("emissiveFactor").get<std::vector<double>>();
+      emissive = glm::dvec3(unit(f[0], "emissiveFactor"), unit(f[1], "emissiveFactor"),
+                            unit(f[2], "emissiveFactor"));
+    }
+    if (m.contains("emissiveTexture")) {
+      // One uv set per vertex (Scene::texcoords): the emissive texture must
+      // read the base colour texture's set, or it is listed as ignored.
+      const json& info = m.at("emissiveTexture");
+      const bool sameSet = !m.contains("pbrMetallicRoughness") ||
+                           !m.at("pbrMetallicRoughness").contains("baseColorTexture") ||
+                           get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0) ==
+                               get<int64_t>(info, "texCoord", 0);
+      if (sameSet)
+        mat.emissiveTexture = decodableTexture(info);
+      else
+        noteIgnored("emissive texture on another texCoord set than the base colour texture", "material");
+    }
+    const std::string mode = get<std::string>(m, "alphaMode", "OPAQUE");
+    mat.alphaMode = mode == "MASK" ? AlphaMode::Mask : mode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+    mat.alphaCutoff = float(get(m, "alphaCutoff", 0.5));
+    if (mat.alphaCutoff < 0.0f) fail(e, "\"alphaCutoff\" must be >= 0");
+    mat.doubleSided = get(m, "doubleSided", false);
+    if (m.contains("extensions")) {
+      const json& ext = m.at("extensions");
+      if (ext.contains("KHR_materials_transmission"))
+        mat.transmission =
+            unit(get(ext.at("KHR_materials_transmission"), "transmissionFactor", 0.0), "transmissionFactor");
+      if (ext.contains("KHR_materials_ior")) {
+        const double ior = get(ext.at("KHR_materials_ior"), "ior", 1.5);
+        if (!(ior >= 1.0)) fail(e + " KHR_materials_ior", "\"ior\" " + std::to_string(ior) + " must be >= 1");
+        mat.ior = float(ior);
+      }
+      if (ext.contains("KHR_materials_emissive_strength")) {
+        const double s = get(ext.at("KHR_materials_emissive_strength"), "emissiveStrength", 1.0);
+        if (!(s >= 0.0)) fail(e + " KHR_materials_emissive_strength", "\"emissiveStrength\" must be >= 0");
+        emissive *= s;
+      }
+    }
+    mat.emissive = glm::vec3(emissive);
+    scene_.materials.push_back(mat);
+  }
+}
+
+int32_t SceneBuilder::decodableTexture(const json& textureInfo) {
+  const int32_t tex = textureInfo.at("index").get<int32_t>();
+  if (scene_.textures[size_t(tex)].image >= 0) return tex;
+  noteIgnored("texture without a decodable image", "textureInfo");
+  return -1;
+}
+
+// COLOR_0 (glTF 2.0 §3.7.2.1): VEC3 or VEC4, float or normalized unsigned
+// byte/short, linear. Empty when the primitive has none.
+std::vector<glm::vec4> SceneBuilder::readColors(const json& attributes, const std::string& element,
+                                                size_t vertexCount) const {
+  if (!attributes.contains("COLOR_0")) return {};
+  const int64_t index = attributes.at("COLOR_0").get<int64_t>();
+  const json& a = array("accessors")[size_t(index)];
+  const std::string e = element + " COLOR_0";
+  const int64_t ct = a.at("componentType").get<int64_t>();
+  if (!(ct == 5126 || ((ct == 5121 || ct == 5123) && get(a, "normalized", false))))
+    fail(e + " (accessor " + std::to_string(index) + ")",
+         "componentType " + std::to_string(ct) + " must be 5126, or 5121 or 5123 with \"normalized\": true");
+  size_t components = 0;
+  const std::vector<double> c = readAccessor(index, e, {"VEC3", "VEC4"}, &components);
+  if (c.size() / components != vertexCount)
+    fail(element, "COLOR_0 has " + std::to_string(c.size() / components) + " elements, POSITION " +
+                      std::to_string(vertexCount));
+  std::vector<glm::vec4> out(vertexCount, glm::vec4(1.0f));
+  for (size_t v = 0; v < vertexCount; ++v)
+    for (size_t k = 0; k < components; ++k)
+      out[v][int(k)] = float(std::clamp(c[v * components + k], 0.0, 1.0));  // float colours may stray
+  return out;
+}
+
+void SceneBuilder::noteIgnored(const std::string& feature, const std::string& unit) {
+  for (IgnoredFeature& f : scene_.ignored)
+    if (f.feature == feature && f.unit == unit) {
+      ++f.count;
+      return;
+    }
+  scene_.ignored.push_back({feature, unit, 1});
+}
+
+// What the checker accepted and nothing renders. Counted over the file's
+// elements (every material, primitive, node), used or not.
+void SceneBuilder::noteIgnoredFeatures() {
+  for (const json& m : array("materials")) {
+    if (m.contains("normalTexture")) noteIgnored("normal texture", "material");
+    if (m.contains("occlusionTexture")) noteIgnored("occlusion texture", "material");
+    if (m.contains("pbrMetallicRoughness") &&
+        m.at("pbrMetallicRoughness").contains("metallicRoughnessTexture"))
+      noteIgnored("metallicRoughness texture", "material");
+    if (m.contains("extensions") && m.at("extensions").contains("KHR_materials_transmission") &&
+        m.at("extensions").at("KHR_materials_transmission").contains("transmissionTexture"))
+      noteIgnored("transmission texture", "material");
+  }
+  for (const json& mesh : array("meshes"))
+    for (const json& prim : mesh.at("primitives")) {
+      if (prim.contains("targets")) noteIgnored("morph targets", "primitive");
+      for (auto it = prim.at("attributes").begin(); it != prim.at("attributes").end(); ++it)
+        if (it.key().rfind("JOINTS_", 0) == 0) {
+          noteIgnored("skinning attributes (JOINTS_n/WEIGHTS_n)", "primitive");
+          break;
+        }
+    }
+  for (const json& n : array("nodes"))
+    if (n.contains("skin")) noteIgnored("skin", "node");
+  for (size_t i = 0; i < array("animations").size(); ++i) noteIgnored("animation", "");
+  std::vector<std::string> path;
+  noteIgnoredExtensions(doc_, path);
+}
+
+// Every extension object in the document whose extension is not supported
+// (KHR_texture_transform, KHR_materials_volume, ...), counted by the kind
+// of element that holds it.
+void SceneBuilder::noteIgnoredExtensions(const json& value, std::vector<std::string>& path) {
+  if (value.is_array()) {
+    for (size_t i = 0; i < value.size(); ++i) {
+      path.push_back("#");  // an array entry: its index does not name the kind
+      noteIgnoredExtensions(value[i], path);
+      path.pop_back();
+    }
+    return;
+  }
+  if (!value.is_object()) return;
+  if (value.contains("extensions") && value.at("extensions").is_object()) {
+    std::string unit = "root object";
+    const size_t n = path.size();
+    if (n >= 1 && path[n - 1].size() > 7 && path[n - 1].compare(path[n - 1].size() - 7, 7, "Texture") == 0)
+      unit = "textureInfo";
+    else if (n == 4 && path[0] == "meshes" && path[2] == "primitives")
+      unit = "primitive";
+    else if (n == 2 && path[1] == "#" && !singular(path[0]).empty())
+      unit = singular(path[0]);
+    else if (n >= 1)
+      unit = path[n - 1] == "#" && n >= 2 ? path[n - 2] + " entry" : "\"" + path[n - 1] + "\"";
+    for (auto it = value.at("extensions").begin(); it != value.at("extensions").end(); ++it)
+      if (!isSupportedExtension(it.key())) noteIgnored(it.key(), unit);
+  }
+  for (auto it = value.begin(); it != value.end(); ++it) {
+    if (it.key() == "extras") continue;  // application data, not glTF
+    path.push_back(it.key());
+    noteIgnoredExtensions(it.value(), path);
+    path.pop_back();
+  }
+}
+
+Scene SceneBuilder::build() {
+  scene_.path = path_;
+  scene_.stats.nodes = uint32_t(array("nodes").size());
+  scene_.stats.meshes = uint32_t(array("meshes").size());
+  scene_.stats.cameras = uint32_t(array("cameras").size());
+  loadTextures();
+  loadMaterials();
+  std::vector<int64_t> parent;
+  checkNodeGraph(parent);
+  walk(rootNodes(parent));
+  noteIgnoredFeatures();
+  return std::move(scene_);
+}
+
+}  // namespace
+
+Scene buildScene(const std::string& path, const nlohmann::json& doc, const tinygltf::Model& model) {
+  return SceneBuilder(path, doc, model).build();
+}
+
+}  // namespace rastray
