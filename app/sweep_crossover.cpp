@@ -402,7 +402,11 @@ std::vector<NamedPlot> crossoverPlots(const StudyMeta& meta, const std::vector<C
       pMin = std::min(pMin, double(s.width) * double(s.height));
       pMax = std::max(pMax, double(s.width) * double(s.height));
     }
-    p.plot.x = {"triangles", "", AxisScale::Log, double(tMin) / 3.0, double(tMax) * 3.0};
+    // Room on the right for "ray caster only" when a renderer did not run.
+    bool allCompared = true;
+    for (const CellResult& r : rows) allCompared = allCompared && r.ok();
+    p.plot.x = {"triangles", "", AxisScale::Log, double(tMin) / 3.0,
+                double(tMax) * (allCompared ? 3.0 : 100.0)};
     p.plot.y = {"image size", "pixels", AxisScale::Log, pMin / 2.0, pMax * 2.0};
     PlotSeries raster{"rasterizer faster", {}, PlotLine::None};
     raster.colour = 0;
