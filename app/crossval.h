@@ -13,16 +13,6 @@
 
 namespace rastray {
 
-// Colour agreement of two renderers where their hits agree: every layer of
-// every sample whose (instance, triangle) list is identical in both.
-struct AgreeingColorStats {
-  uint64_t layers = 0;    // layers compared
-  double maxError = 0.0;  // largest |A − B| over RGBA
-  int maxX = -1, maxY = -1;
-};
-
-AgreeingColorStats colorWhereHitsAgree(const DeepImage& a, const DeepImage& b);
-
 // The compare tool's name for the rasterizer's depth format (compare/
 // knows neither renderer).
 StoredDepthFormat storedDepthFormat(DepthFormat format);

@@ -32,10 +32,17 @@ void printErrorLine(const std::string& message) {
   std::fprintf(stderr, "%s\n", line.c_str());
 }
 
+// An internal check failed (common/error.h): the library aborts after this.
+void printCheckFailure(const std::string& message) {
+  std::fprintf(stderr, "rastray: %s\n", message.c_str());
+  std::fflush(stderr);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace rastray;
+  setCheckFailureHandler(&printCheckFailure);
   CLI::App app{
       "rastray: render one glTF scene with a z-buffer rasterizer and an Embree ray caster, "
       "and compare them sample by sample"};

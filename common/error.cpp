@@ -1,6 +1,6 @@
 #include "common/error.h"
 
-#include <cstdio>
+#include <atomic>
 #include <cstdlib>
 
 namespace rastray {
@@ -11,6 +11,9 @@ std::string joinWhere(const std::string& file, const std::string& element, const
   if (!element.empty()) s += ": " + element;
   return s + ": " + message;
 }
+
+// Set once at start-up by the program, read by any thread that fails a check.
+std::atomic<CheckFailureHandler> checkFailureHandler{nullptr};
 }  // namespace
 
 InputError::InputError(std::string file, std::string element, std::string message)
@@ -19,9 +22,14 @@ InputError::InputError(std::string file, std::string element, std::string messag
       element_(std::move(element)),
       message_(std::move(message)) {}
 
+CheckFailureHandler setCheckFailureHandler(CheckFailureHandler handler) {
+  return checkFailureHandler.exchange(handler);
+}
+
 void checkFailed(const char* expr, const char* file, int line, const std::string& detail) {
-  std::fprintf(stderr, "rastray: internal check failed at %s:%d: %s (%s)\n", file, line, expr,
-               detail.c_str());
+  if (const CheckFailureHandler handler = checkFailureHandler.load())
+    handler("internal check failed at " + std::string(file) + ":" + std::to_string(line) + ": " + expr +
+            " (" + detail + ")");
   std::abort();
 }
 

@@ -24,10 +24,20 @@ class InputError : public std::runtime_error {
   std::string file_, element_, message_;
 };
 
-// Internal invariant check that prints the values involved; on in every
-// build (Release keeps assertions), because a wrong image is worse than a
-// stopped one.
+// Internal invariant check with the values involved; on in every build
+// (Release keeps assertions), because a wrong image is worse than a
+// stopped one. A failure formats "internal check failed at FILE:LINE:
+// EXPR (DETAIL)", hands it to the program's handler and aborts. The
+// libraries never print: app/main.cpp's handler writes the line to stderr,
+// so do the test binaries' (tests/print_check_failures.cpp); without a
+// handler the message is lost and the process still aborts.
 [[noreturn]] void checkFailed(const char* expr, const char* file, int line, const std::string& detail);
+
+using CheckFailureHandler = void (*)(const std::string& message);
+// Installs `handler` (nullptr: none) and returns the previous one. The
+// handler must not return to the failed check's caller by throwing; it
+// may return normally (the process then aborts).
+CheckFailureHandler setCheckFailureHandler(CheckFailureHandler handler);
 
 #define RASTRAY_CHECK(cond, detail)                                           \
   do {                                                                        \

@@ -11,6 +11,32 @@ namespace rastray {
 
 namespace {
 
+// The entries of one sample of one pixel: [begin, end) into samples.
+struct SampleRange {
+  uint64_t begin = 0, end = 0;
+};
+
+// Splits a pixel's entries (sorted by sample index first) by sample.
+std::vector<SampleRange> splitBySample(const DeepImage& image, size_t pixel, uint32_t spp) {
+  std::vector<SampleRange> ranges(spp);
+  uint64_t i = image.offsets[pixel];
+  const uint64_t end = image.offsets[pixel + 1];
+  while (i < end) {
+    const uint32_t s = image.samples[i].sample;
+    uint64_t j = i;
+    while (j < end && image.samples[j].sample == s) ++j;
+    if (s < spp) ranges[s] = {i, j};
+    i = j;
+  }
+  return ranges;
+}
+
+uint32_t sampleCount(const DeepImage& image) {
+  uint32_t spp = 0;
+  for (const DeepSample& s : image.samples) spp = std::max(spp, s.sample + 1);
+  return spp;
+}
+
 OIIO::ImageBuf toImageBuf(const FlatImage& image) {
   OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
   OIIO::ImageBuf buf(spec);
@@ -81,6 +107,37 @@ std::vector<float> colorDifference(const FlatImage& a, const FlatImage& b) {
     diff[i] = std::max(std::max(d.r, d.g), std::max(d.b, d.a));
   }
   return diff;
+}
+
+AgreeingColorStats colorWhereHitsAgree(const DeepImage& a, const DeepImage& b) {
+  AgreeingColorStats stats;
+  const uint32_t spp = std::max(sampleCount(a), sampleCount(b));
+  const size_t pixels = size_t(a.width) * size_t(a.height);
+  for (size_t p = 0; p < pixels; ++p) {
+    const auto ra = splitBySample(a, p, spp), rb = splitBySample(b, p, spp);
+    for (uint32_t s = 0; s < spp; ++s) {
+      const uint32_t n = ra[s].end - ra[s].begin;
+      if (n != rb[s].end - rb[s].begin) continue;
+      bool same = true;
+      for (uint32_t k = 0; k < n && same; ++k) {
+        const DeepSample& x = a.samples[ra[s].begin + k];
+        const DeepSample& y = b.samples[rb[s].begin + k];
+        same = x.instance == y.instance && x.triangle == y.triangle;
+      }
+      if (!same) continue;
+      for (uint32_t k = 0; k < n; ++k) {
+        const glm::vec4 d = glm::abs(a.samples[ra[s].begin + k].color - b.samples[rb[s].begin + k].color);
+        const double e = std::max(std::max(d.r, d.g), std::max(d.b, d.a));
+        ++stats.layers;
+        if (e > stats.maxError) {
+          stats.maxError = e;
+          stats.maxX = int(p % size_t(a.width));
+          stats.maxY = int(p / size_t(a.width));
+        }
+      }
+    }
+  }
+  return stats;
 }
 
 }  // namespace rastray

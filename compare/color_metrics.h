@@ -51,4 +51,18 @@ FlatImage flattenDeepColor(const DeepImage& deep, int spp);
 // Per-pixel largest |A − B| over RGBA, for the heat map.
 std::vector<float> colorDifference(const FlatImage& a, const FlatImage& b);
 
+// Colour agreement of two frames where their hits agree: every layer of
+// every sample whose (instance, triangle) list, front to back, is identical
+// in both. Separates shading differences from visibility differences
+// (crossval: hybrid and the ray caster shade the same hits identically, so
+// their maxError must be 0). Frames of the same size; spp is taken as the
+// larger sample index + 1 of the two.
+struct AgreeingColorStats {
+  uint64_t layers = 0;    // layers compared
+  double maxError = 0.0;  // largest |A − B| over RGBA
+  int maxX = -1, maxY = -1;
+};
+
+AgreeingColorStats colorWhereHitsAgree(const DeepImage& a, const DeepImage& b);
+
 }  // namespace rastray

@@ -6,11 +6,12 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/math_constants.h"
+
 namespace rastray {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr DepthFormat kMapFormat = DepthFormat::FloatReversed;
 
 // A camera at `eye` looking along `forward`.

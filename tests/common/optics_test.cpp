@@ -1,3 +1,6 @@
+// Reflection, Snell refraction, exact Fresnel and total internal
+// reflection: the functions of common/optics.h alone (the ray caster's use
+// of them is tested in tests/raytrace/optics_test.cpp).
 #include "common/optics.h"
 
 #include <cmath>
@@ -7,27 +10,64 @@
 namespace rastray {
 namespace {
 
-TEST(Optics, FresnelAtNormalIncidence) {
+// Fresnel transmittance computed independently from the reflectance
+// (the amplitude transmission coefficients with the power factor
+// n2 cosθt / n1 cosθi), so R + T = 1 is a real check.
+double fresnelTransmittance(double cosI, double eta) {
+  const double sin2T = eta * eta * (1.0 - cosI * cosI);
+  if (sin2T >= 1.0) return 0.0;
+  const double cosT = std::sqrt(1.0 - sin2T);
+  // n1 = eta, n2 = 1.
+  const double ts = 2.0 * eta * cosI / (eta * cosI + cosT);
+  const double tp = 2.0 * eta * cosI / (cosI + eta * cosT);
+  const double factor = cosT / (eta * cosI);
+  return 0.5 * factor * (ts * ts + tp * tp);
+}
+
+TEST(Optics, FresnelAtNormalIncidenceMatchesClosedForm) {
   for (double n : {1.33, 1.5, 2.4}) {
-    const double expected = std::pow((n - 1.0) / (n + 1.0), 2.0);
-    EXPECT_NEAR(fresnelDielectric(1.0, 1.0 / n), expected, 1e-12) << "entering, n = " << n;
-    EXPECT_NEAR(fresnelDielectric(1.0, n), expected, 1e-12) << "leaving, n = " << n;
+    const double expected = ((n - 1.0) / (n + 1.0)) * ((n - 1.0) / (n + 1.0));
+    EXPECT_NEAR(fresnelDielectric(1.0, 1.0 / n), expected, 1e-15) << "entering n " << n;
+    EXPECT_NEAR(fresnelDielectric(1.0, n), expected, 1e-15) << "leaving n " << n;
   }
 }
 
-TEST(Optics, TotalInternalReflectionAtTheCriticalAngle) {
-  const double n = 1.5;
-  const double critical = std::asin(1.0 / n);
-  const glm::dvec3 normal(0.0, 0.0, 1.0);
-  auto incidentAt = [&](double theta) { return glm::dvec3(std::sin(theta), 0.0, -std::cos(theta)); };
-  // Leaving glass (eta = n): refraction just before, TIR just past.
-  EXPECT_TRUE(refract(incidentAt(critical - 1e-6), normal, n).has_value());
-  EXPECT_FALSE(refract(incidentAt(critical + 1e-6), normal, n).has_value());
-  EXPECT_EQ(fresnelDielectric(std::cos(critical + 1e-6), n), 1.0);
-  EXPECT_LT(fresnelDielectric(std::cos(critical - 1e-3), n), 1.0);
+TEST(Optics, ReflectanceAndTransmittanceSumToOne) {
+  for (double eta : {1.0 / 1.5, 1.5, 1.0 / 2.4})
+    for (int i = 0; i <= 100; ++i) {
+      const double cosI = i / 100.0;
+      const double R = fresnelDielectric(cosI, eta);
+      const double T = fresnelTransmittance(cosI, eta);
+      ASSERT_GE(R, 0.0);
+      ASSERT_LE(R, 1.0);
+      if (cosI > 0.0) {
+        EXPECT_NEAR(R + T, 1.0, 1e-12) << "eta " << eta << " cosI " << cosI;
+      }
+    }
+  // Grazing incidence reflects everything.
+  EXPECT_NEAR(fresnelDielectric(0.0, 1.0 / 1.5), 1.0, 1e-12);
 }
 
-TEST(Optics, SnellsLawHolds) {
+TEST(Optics, TotalInternalReflectionJustPastTheCriticalAngle) {
+  const double eta = 1.5;  // leaving glass
+  const double critical = std::asin(1.0 / eta);
+  const glm::dvec3 n(0.0, 0.0, 1.0);
+  for (double delta : {1e-6, 1e-3, 0.01}) {
+    const double past = critical + delta, before = critical - delta;
+    const glm::dvec3 dPast(std::sin(past), 0.0, -std::cos(past));
+    const glm::dvec3 dBefore(std::sin(before), 0.0, -std::cos(before));
+    EXPECT_FALSE(refract(dPast, n, eta).has_value()) << "delta " << delta;
+    EXPECT_EQ(fresnelDielectric(std::cos(past), eta), 1.0);
+    const auto t = refract(dBefore, n, eta);
+    ASSERT_TRUE(t.has_value()) << "delta " << delta;
+    EXPECT_LT(fresnelDielectric(std::cos(before), eta), 1.0);
+    // Snell: n1 sinθi = n2 sinθt, with the refracted ray on the far side.
+    EXPECT_NEAR(std::sqrt(t->x * t->x + t->y * t->y), eta * std::sin(before), 1e-9);
+    EXPECT_LT(t->z, 0.0);
+  }
+}
+
+TEST(Optics, SnellsLawHoldsEnteringGlass) {
   const glm::dvec3 normal(0.0, 0.0, 1.0);
   for (double theta : {0.0, 0.3, 0.7, 1.2, 1.5}) {
     const glm::dvec3 in(std::sin(theta), 0.0, -std::cos(theta));
@@ -38,17 +78,6 @@ TEST(Optics, SnellsLawHolds) {
     EXPECT_NEAR(1.0 * std::sin(theta), 1.5 * sinT, 1e-12) << theta;
     EXPECT_LT(out->z, 0.0);  // continues into the surface
   }
-}
-
-TEST(Optics, ReflectanceStaysInUnitRange) {
-  for (double c = 0.0; c <= 1.0; c += 0.01)
-    for (double eta : {1.0 / 1.5, 1.5}) {
-      const double f = fresnelDielectric(c, eta);
-      EXPECT_GE(f, 0.0);
-      EXPECT_LE(f, 1.0);
-    }
-  // Grazing incidence reflects everything.
-  EXPECT_NEAR(fresnelDielectric(0.0, 1.0 / 1.5), 1.0, 1e-12);
 }
 
 TEST(Optics, ReflectMirrorsAboutTheNormal) {

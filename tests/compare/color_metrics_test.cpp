@@ -89,6 +89,44 @@ TEST(ColorMetrics, DeepFlattenCompositesThenAverages) {
   EXPECT_FLOAT_EQ(f.color[0].a, 0.5f);
 }
 
+// A deep layer for colorWhereHitsAgree: hit (instance, 0) at `sample`.
+DeepSample layer(uint32_t sample, uint32_t instance, glm::vec4 color) {
+  DeepSample d;
+  d.sample = sample;
+  d.instance = instance;
+  d.triangle = 0;
+  d.color = color;
+  return d;
+}
+
+TEST(ColorWhereHitsAgree, ComparesOnlySamplesWithTheSameHitList) {
+  // Two pixels at 2 spp. Pixel 0: sample 0 has the same two layers in both
+  // (second layer differs by 0.25 in green); sample 1 hits instance 1 in A
+  // and instance 2 in B (a visibility difference, left out, although its
+  // colour differs by 1). Pixel 1: sample 0 agrees with a 0.5 difference in
+  // blue; sample 1 has one layer in A and two in B (left out).
+  DeepImage a, b;
+  a.width = b.width = 2;
+  a.height = b.height = 1;
+  const glm::vec4 grey(0.5f, 0.5f, 0.5f, 1.0f);
+  a.samples = {layer(0, 1, grey), layer(0, 3, grey), layer(1, 1, {0, 0, 0, 1}),  // pixel 0
+               layer(0, 4, grey), layer(1, 5, grey)};                            // pixel 1
+  a.offsets = {0, 3, 5};
+  b.samples = {layer(0, 1, grey),         layer(0, 3, {0.5f, 0.75f, 0.5f, 1.0f}),
+               layer(1, 2, {1, 1, 1, 1}), layer(0, 4, {0.5f, 0.5f, 1.0f, 1.0f}),
+               layer(1, 5, grey),         layer(1, 6, grey)};
+  b.offsets = {0, 3, 6};
+  const AgreeingColorStats s = colorWhereHitsAgree(a, b);
+  EXPECT_EQ(s.layers, 3u);  // pixel 0 sample 0 (two layers), pixel 1 sample 0
+  EXPECT_DOUBLE_EQ(s.maxError, 0.5);
+  EXPECT_EQ(s.maxX, 1);
+  EXPECT_EQ(s.maxY, 0);
+  // The same frame against itself: every layer compared, no error.
+  const AgreeingColorStats same = colorWhereHitsAgree(b, b);
+  EXPECT_EQ(same.layers, 6u);
+  EXPECT_EQ(same.maxError, 0.0);
+}
+
 // Reads an 8-bit PNG back as bytes.
 std::vector<uint8_t> readPng(const std::string& path, int* w, int* h) {
   auto in = OIIO::ImageInput::open(path);
