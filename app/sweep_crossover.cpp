@@ -526,7 +526,7 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
   limits.addressSpaceBytes = options.childMemoryLimitBytes;
   if (limits.addressSpaceBytes == 0 && !kAddressSanitizer)
     limits.addressSpaceBytes = uint64_t(0.85 * double(availableMemoryBytes()));
-  const int maxRuns = std::max(1, options.quick ? 1 : options.maxRuns);
+  const int maxRuns = std::max(1, options.maxRuns);
   meta.childMemoryLimit = limits.addressSpaceBytes;
 
   meta.loadStart = loadAverage();

@@ -17,7 +17,7 @@
 // - peak resident memory of each variant's process (libraries and the loaded
 //   scene included).
 // Times are the child's own (renderScene's clock), the fastest of 3 runs
-// when a run takes under 5 s (--quick: 1 run), else of 1: other work on the
+// when a run takes under 5 s, else of 1: other work on the
 // machine only ever adds time. A cell that runs out of memory (each
 // child's address space is limited to 85% of the memory available when the
 // study starts), is killed or times out is recorded as such, and the larger
@@ -54,7 +54,7 @@ struct CrossoverOptions {
   std::vector<uint64_t> triangles;
   std::vector<ImageSize> sizes;
   std::string rastray;  // the binary each cell runs; empty: this process's own
-  int maxRuns = 3;      // runs per scene variant when a run is short (quick: 1)
+  int maxRuns = 3;      // runs per scene variant when a run is short
   double cellTimeoutSeconds = 900;
   // Each child's address space; 0: 85% of the memory available at the start
   // (none in an AddressSanitizer build, whose shadow memory needs terabytes
