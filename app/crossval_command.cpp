@@ -118,7 +118,8 @@ int runCrossval(CrossvalOptions& opt) {
         if (terminal)
           std::fprintf(stderr, "\rexplaining %s: %-20s", r.scenePath.c_str(), toString(MismatchClass(c)));
         const std::string file = std::string("explain-") + toString(MismatchClass(c)) + ".txt";
-        writeTextFile(folder + "/" + file, explainPixel(scene, opt.settings, example->x, example->y));
+        writeTextFile(folder + "/" + file,
+                      explanationText(explainPixel(scene, opt.settings, example->x, example->y)));
         explanations[i].push_back({toString(MismatchClass(c)), file});
       }
     }
@@ -166,10 +167,9 @@ int runCrossval(CrossvalOptions& opt) {
           (unsigned long long)v.layers.count(MismatchClass::DepthTie),
           (unsigned long long)v.layers.count(MismatchClass::NearFarPlane),
           (unsigned long long)v.layers.count(MismatchClass::Genuine), (unsigned long long)v.layers.cutOff,
-          (unsigned long long)r.hybridVsRay.layers.count(MismatchClass::Genuine),
-          v.depth.maxRelative, r.rasterVsRayColor.rmsError,
-          std::isinf(r.rasterVsRayColor.psnr) ? 999.9 : r.rasterVsRayColor.psnr, r.hybridWhereAgree.maxError,
-          r.raster.seconds, r.raytrace.seconds, r.hybrid.seconds);
+          (unsigned long long)r.hybridVsRay.layers.count(MismatchClass::Genuine), v.depth.maxRelative,
+          r.rasterVsRayColor.rmsError, std::isinf(r.rasterVsRayColor.psnr) ? 999.9 : r.rasterVsRayColor.psnr,
+          r.hybridWhereAgree.maxError, r.raster.seconds, r.raytrace.seconds, r.hybrid.seconds);
     }
     if (!opt.reportDir.empty()) std::printf("\nreport: %s/index.html\n", opt.reportDir.c_str());
     for (const std::string& f : failures) std::printf("FAIL %s\n", f.c_str());

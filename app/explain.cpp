@@ -4,7 +4,9 @@
 // side with the mismatch class of each disagreement.
 #include "app/explain.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <iostream>
 #include <memory>
 
 #include "app/commands.h"
@@ -18,7 +20,7 @@ namespace rastray {
 
 namespace {
 
-std::string hitText(const DeepSample* s) {
+std::string hitText(const std::optional<DeepSample>& s) {
   if (!s) return "nothing";
   char buf[128];
   std::snprintf(buf, sizeof buf, "(%u, %u) Z %.9g", s->instance, s->triangle, double(s->depth));
@@ -35,7 +37,7 @@ std::vector<const DeepSample*> layersOf(const DeepImage& image, size_t p, uint32
 
 }  // namespace
 
-std::string explainPixel(const Scene& scene, const RenderSettings& settings, int x, int y) {
+PixelExplanation explainPixel(const Scene& scene, const RenderSettings& settings, int x, int y) {
   RenderSettings s = settings;
   s.debugPixel = glm::ivec2(x, y);
   // Each renderer records what it did at the pixel into its own log.
@@ -44,25 +46,22 @@ std::string explainPixel(const Scene& scene, const RenderSettings& settings, int
   s.ray.trace = {&rayLog, {x, y}};
   s.keepSamples = true;
 
-  std::string out;
-  char line[512];
   s.renderer = RendererKind::Raster;
   const RenderRun raster = renderScene(scene, s);
   s.renderer = RendererKind::Raytrace;
   const RenderRun ray = renderScene(scene, s);
-  const std::string rasterTrace = rasterLog.text(), rayTrace = rayTreeText(rayLog.events(), {x, y});
 
-  std::snprintf(line, sizeof line, "pixel (%d, %d) of %s, %dx%d, %d spp\ncamera %s\n\n", x, y,
-                scene.path.c_str(), raster.camera.width, raster.camera.height, s.spp,
-                raster.camera.describe().c_str());
-  out += line;
-  if (scene.origin != glm::dvec3(0.0)) {
-    // Traced ray origins below are in the rebased frame (--origin camera).
-    std::snprintf(line, sizeof line,
-                  "positions below are relative to the render origin (%.17g, %.17g, %.17g)\n\n",
-                  scene.origin.x, scene.origin.y, scene.origin.z);
-    out += line;
-  }
+  PixelExplanation e;
+  e.scenePath = scene.path;
+  e.x = x;
+  e.y = y;
+  e.width = raster.camera.width;
+  e.height = raster.camera.height;
+  e.spp = s.spp;
+  e.camera = raster.camera.describe();
+  e.renderOrigin = scene.origin;
+  e.rasterEvents = rasterLog.events();
+  e.rayEvents = rayLog.events();
 
   // Hits side by side, with the mismatch class of each disagreement.
   ClassifierSettings cs;
@@ -73,40 +72,124 @@ std::string explainPixel(const Scene& scene, const RenderSettings& settings, int
   MismatchClassifier classifier(cs);
   const auto positions = samplePositions(s.spp);
   const size_t p = size_t(y) * size_t(raster.camera.width) + size_t(x);
-  out += "== hits per sample (instance, triangle) and view depth, front to back ==\n";
   for (uint32_t i = 0; i < positions.size(); ++i) {
-    const glm::dvec2 pos = glm::dvec2(x, y) + positions[i];
-    std::snprintf(line, sizeof line, "sample %u at (%.4f, %.4f)\n", i, pos.x, pos.y);
-    out += line;
+    ExplainedSample sample;
+    sample.index = i;
+    sample.position = glm::dvec2(x, y) + positions[i];
     const auto a = layersOf(raster.output.samples, p, i), b = layersOf(ray.output.samples, p, i);
     for (size_t k = 0; k < std::max({a.size(), b.size(), size_t(1)}); ++k) {
-      const DeepSample* la = k < a.size() ? a[k] : nullptr;
-      const DeepSample* lb = k < b.size() ? b[k] : nullptr;
+      ExplainedLayer layer;
       HitRecord ha, hb;
-      if (la) ha = {la->instance, la->triangle, la->depth};
-      if (lb) hb = {lb->instance, lb->triangle, lb->depth};
-      std::string verdict = "agree";
-      if (!ha.sameSurface(hb)) verdict = displayName(classifier.classify(pos, ha, hb, ImageSpaceEvidence{}));
-      std::snprintf(line, sizeof line, "  layer %zu: raster %-34s raytrace %-34s %s\n", k,
-                    hitText(la).c_str(), hitText(lb).c_str(), verdict.c_str());
-      out += line;
+      if (k < a.size()) {
+        layer.raster = *a[k];
+        ha = {a[k]->instance, a[k]->triangle, a[k]->depth};
+      }
+      if (k < b.size()) {
+        layer.raytrace = *b[k];
+        hb = {b[k]->instance, b[k]->triangle, b[k]->depth};
+      }
+      layer.verdict = "agree";
       if (!ha.sameSurface(hb)) {
-        if (ha.isHit()) {
-          std::snprintf(line, sizeof line, "           distance to raster triangle's edges %.4g px\n",
-                        classifier.distanceToTriangleEdges(pos, ha));
-          out += line;
-        }
-        if (hb.isHit()) {
-          std::snprintf(line, sizeof line, "           distance to raytrace triangle's edges %.4g px\n",
-                        classifier.distanceToTriangleEdges(pos, hb));
-          out += line;
-        }
+        layer.verdict = displayName(classifier.classify(sample.position, ha, hb, ImageSpaceEvidence{}));
+        if (ha.isHit()) layer.rasterEdgeDistance = classifier.distanceToTriangleEdges(sample.position, ha);
+        if (hb.isHit()) layer.raytraceEdgeDistance = classifier.distanceToTriangleEdges(sample.position, hb);
+      }
+      sample.layers.push_back(layer);
+    }
+    e.samples.push_back(sample);
+  }
+  return e;
+}
+
+std::string explanationText(const PixelExplanation& e) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "pixel (%d, %d) of %s, %dx%d, %d spp\ncamera %s\n\n", e.x, e.y,
+                e.scenePath.c_str(), e.width, e.height, e.spp, e.camera.c_str());
+  out += line;
+  if (e.renderOrigin != glm::dvec3(0.0)) {
+    // Traced ray origins below are in the rebased frame (--origin camera).
+    std::snprintf(line, sizeof line,
+                  "positions below are relative to the render origin (%.17g, %.17g, %.17g)\n\n",
+                  e.renderOrigin.x, e.renderOrigin.y, e.renderOrigin.z);
+    out += line;
+  }
+  out += "== hits per sample (instance, triangle) and view depth, front to back ==\n";
+  for (const ExplainedSample& sample : e.samples) {
+    std::snprintf(line, sizeof line, "sample %u at (%.4f, %.4f)\n", sample.index, sample.position.x,
+                  sample.position.y);
+    out += line;
+    for (size_t k = 0; k < sample.layers.size(); ++k) {
+      const ExplainedLayer& layer = sample.layers[k];
+      std::snprintf(line, sizeof line, "  layer %zu: raster %-34s raytrace %-34s %s\n", k,
+                    hitText(layer.raster).c_str(), hitText(layer.raytrace).c_str(), layer.verdict.c_str());
+      out += line;
+      if (layer.rasterEdgeDistance) {
+        std::snprintf(line, sizeof line, "           distance to raster triangle's edges %.4g px\n",
+                      *layer.rasterEdgeDistance);
+        out += line;
+      }
+      if (layer.raytraceEdgeDistance) {
+        std::snprintf(line, sizeof line, "           distance to raytrace triangle's edges %.4g px\n",
+                      *layer.raytraceEdgeDistance);
+        out += line;
       }
     }
   }
-  out += "\n== rasterizer: coverage, fill rule, depth tests, layers ==\n" + rasterTrace;
-  out += "\n== ray caster: ray tree ==\n" + rayTrace;
+  out += "\n== rasterizer: coverage, fill rule, depth tests, layers ==\n" + traceText(e.rasterEvents);
+  out += "\n== ray caster: ray tree ==\n" + rayTreeText(e.rayEvents, {e.x, e.y});
   return out;
+}
+
+nlohmann::ordered_json explanationJson(const PixelExplanation& e) {
+  using json = nlohmann::ordered_json;
+  auto hit = [](const std::optional<DeepSample>& s) -> json {
+    if (!s) return nullptr;
+    return {{"instance", s->instance}, {"triangle", s->triangle}, {"depth", s->depth}};
+  };
+  auto events = [](const std::vector<TraceEvent>& list) {
+    json out = json::array();
+    for (const TraceEvent& ev : list) {
+      json values = json::object();
+      for (const auto& [name, value] : ev.values) {
+        // Names are unique within an event; a repeated one keeps both values.
+        std::string key = name;
+        for (int n = 2; values.contains(key); ++n) key = name + "#" + std::to_string(n);
+        values[key] = value;
+      }
+      out.push_back({{"stage", toString(ev.stage)},
+                     {"sample", ev.sample >= 0 ? json(ev.sample) : json(nullptr)},
+                     {"instance", ev.instance != kNoId ? json(ev.instance) : json(nullptr)},
+                     {"triangle", ev.triangle != kNoId ? json(ev.triangle) : json(nullptr)},
+                     {"depth", ev.depth},
+                     {"outcome", ev.outcome},
+                     {"values", values}});
+    }
+    return out;
+  };
+  json samples = json::array();
+  for (const ExplainedSample& sample : e.samples) {
+    json layers = json::array();
+    for (const ExplainedLayer& layer : sample.layers) {
+      json l = {{"raster", hit(layer.raster)}, {"raytrace", hit(layer.raytrace)}, {"verdict", layer.verdict}};
+      if (layer.rasterEdgeDistance) l["rasterEdgeDistance"] = *layer.rasterEdgeDistance;
+      if (layer.raytraceEdgeDistance) l["raytraceEdgeDistance"] = *layer.raytraceEdgeDistance;
+      layers.push_back(l);
+    }
+    samples.push_back(
+        {{"sample", sample.index}, {"position", {sample.position.x, sample.position.y}}, {"layers", layers}});
+  }
+  return {{"schema", "rastray.explain"},
+          {"version", 1},
+          {"scene", e.scenePath},
+          {"pixel", {e.x, e.y}},
+          {"size", {e.width, e.height}},
+          {"spp", e.spp},
+          {"camera", e.camera},
+          {"renderOrigin", {e.renderOrigin.x, e.renderOrigin.y, e.renderOrigin.z}},
+          {"samples", samples},
+          {"raster", {{"events", events(e.rasterEvents)}}},
+          {"raytrace", {{"events", events(e.rayEvents)}}}};
 }
 
 namespace {
@@ -114,6 +197,7 @@ namespace {
 struct ExplainOptions {
   std::string scenePath;
   int x = 0, y = 0;
+  bool json = false;
   RenderSettings settings;
 };
 
@@ -124,7 +208,11 @@ int runExplain(ExplainOptions& opt) {
     throw InputError(
         "command line", "X Y",
         "pixel (" + std::to_string(opt.x) + ", " + std::to_string(opt.y) + ") lies outside the image");
-  std::fputs(explainPixel(scene, opt.settings, opt.x, opt.y).c_str(), stdout);
+  const PixelExplanation e = explainPixel(scene, opt.settings, opt.x, opt.y);
+  if (opt.json)
+    std::cout << explanationJson(e).dump(2) << "\n";
+  else
+    std::fputs(explanationText(e).c_str(), stdout);
   return 0;
 }
 
@@ -138,6 +226,8 @@ CommandRunner addExplainCommand(CLI::App& app) {
   cmd->add_option("scene", opt->scenePath, "glTF 2.0 file")->required();
   cmd->add_option("x", opt->x, "Pixel column (0 = left)")->required();
   cmd->add_option("y", opt->y, "Pixel row (0 = top)")->required();
+  cmd->add_flag("--json", opt->json,
+                "Print the hits and every trace event as JSON (schema rastray.explain) for programs");
   addRenderSettings(*cmd, opt->settings, /*withRenderer=*/false);
   return [opt, cmd]() -> int { return cmd->parsed() ? runExplain(*opt) : -1; };
 }

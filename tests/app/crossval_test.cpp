@@ -127,7 +127,107 @@ TEST(Explain, ShowsBothRenderersAndTheirHits) {
   EXPECT_NE(r.out.find("edge 0 a "), std::string::npos);  // setup event: edge 0 and its a, b, c
   EXPECT_NE(r.out.find("== ray caster"), std::string::npos);
   EXPECT_NE(r.out.find("sample 3"), std::string::npos);
+  // Coverage (edge function values at a sample), the depth test, and the ray tree.
+  EXPECT_NE(r.out.find("  cover sample 0 instance 0 triangle 0: E0 "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  depth sample 0 instance 0 triangle 0: key 0x"), std::string::npos) << r.out;
+  EXPECT_NE(
+      r.out.find("ray tree of pixel (40, 40): 4 rays\nray sample 0 instance 0 triangle 0: kind primary"),
+      std::string::npos)
+      << r.out;
   EXPECT_EQ(runRastray({"explain", scene("three-triangles"), "80", "0", "--size", "80", "80"}).status, 2);
+}
+
+// The lines of `text` between the line starting with `from` and the next
+// empty line (or the end).
+std::vector<std::string> sectionLines(const std::string& text, const std::string& from) {
+  std::vector<std::string> lines;
+  std::istringstream in(text.substr(text.find(from)));
+  std::string line;
+  std::getline(in, line);  // the heading
+  while (std::getline(in, line) && !line.empty()) lines.push_back(line);
+  return lines;
+}
+
+// explain --json carries the same events as the text, one object per line
+// of each renderer's section, with the fields programs need.
+TEST(Explain, JsonHasTheSameEventsAsTheText) {
+  const std::vector<std::string> args = {
+      "explain", scene("cornell-box"), "100", "60", "--size", "160", "120", "--spp", "4"};
+  const auto text = runRastray(args);
+  ASSERT_EQ(text.status, 0) << text.err;
+  std::vector<std::string> jsonArgs = args;
+  jsonArgs.push_back("--json");
+  const auto r = runRastray(jsonArgs);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j.at("schema"), "rastray.explain");
+  EXPECT_EQ(j.at("version"), 1);
+  EXPECT_EQ(j.at("pixel"), json::array({100, 60}));
+  EXPECT_EQ(j.at("size"), json::array({160, 120}));
+  EXPECT_EQ(j.at("spp"), 4);
+
+  // Hits: one entry per sample, each with at least one layer and a verdict.
+  ASSERT_EQ(j.at("samples").size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    const json& s = j.at("samples")[i];
+    EXPECT_EQ(s.at("sample"), i);
+    EXPECT_GE(s.at("position")[0].get<double>(), 100.0);
+    EXPECT_LT(s.at("position")[0].get<double>(), 101.0);
+    ASSERT_FALSE(s.at("layers").empty());
+    const json& l = s.at("layers")[0];
+    EXPECT_EQ(l.at("raster").at("instance"), l.at("raytrace").at("instance"));
+    EXPECT_EQ(l.at("verdict"), "agree");
+  }
+
+  // Raster events: as many as lines in the text's rasterizer section, in
+  // the same order, each with its stage first on the line.
+  const json& raster = j.at("raster").at("events");
+  const auto rasterLines = sectionLines(text.out, "== rasterizer");
+  ASSERT_EQ(raster.size(), rasterLines.size()) << text.out;
+  bool covered = false, depthPass = false;
+  for (size_t i = 0; i < raster.size(); ++i) {
+    const json& e = raster[i];
+    const std::string stage = e.at("stage");
+    EXPECT_EQ(rasterLines[i].find_first_not_of(' '), 2 * e.at("depth").get<size_t>()) << rasterLines[i];
+    EXPECT_EQ(rasterLines[i].substr(rasterLines[i].find_first_not_of(' '), stage.size()), stage);
+    if (!e.at("outcome").get<std::string>().empty())
+      EXPECT_NE(rasterLines[i].find(" -> " + e.at("outcome").get<std::string>()), std::string::npos);
+    for (const auto& [name, value] : e.at("values").items())
+      EXPECT_NE(rasterLines[i].find(" " + name + " " + value.get<std::string>()), std::string::npos)
+          << rasterLines[i];
+    if (stage == "cover") {
+      EXPECT_TRUE(e.at("sample").is_number() && e.at("instance").is_number() && e.at("triangle").is_number());
+      EXPECT_TRUE(e.at("values").contains("E0") && e.at("values").contains("E2"));
+      covered = covered || e.at("outcome") == "covered";
+    }
+    if (stage == "depth") {
+      EXPECT_EQ(e.at("values").at("key").get<std::string>().rfind("0x", 0), 0u);
+      depthPass = depthPass || e.at("outcome") == "pass";
+    }
+  }
+  EXPECT_EQ(raster.front().at("stage"), "tile");
+  EXPECT_TRUE(raster.front().at("sample").is_null());
+  EXPECT_TRUE(covered);
+  EXPECT_TRUE(depthPass);
+
+  // Ray caster events: the ray tree, one event per ray line; a primary ray
+  // per sample, each hitting the floor the raster hits.
+  const json& rays = j.at("raytrace").at("events");
+  const auto rayLines = sectionLines(text.out, "ray tree of pixel (100, 60): ");
+  ASSERT_EQ(rays.size(), rayLines.size()) << text.out;
+  EXPECT_NE(text.out.find("ray tree of pixel (100, 60): " + std::to_string(rays.size()) + " rays"),
+            std::string::npos);
+  int primaries = 0;
+  for (const json& e : rays) {
+    EXPECT_EQ(e.at("stage"), "ray");
+    if (e.at("values").at("kind") != "primary") continue;
+    EXPECT_EQ(e.at("sample"), primaries);
+    EXPECT_EQ(e.at("outcome"), "hit");
+    EXPECT_EQ(e.at("instance"),
+              j.at("samples")[size_t(primaries)].at("layers")[0].at("raster").at("instance"));
+    ++primaries;
+  }
+  EXPECT_EQ(primaries, 4);
 }
 
 // --debug-pixel: the rasterizer records, the command prints the events to
