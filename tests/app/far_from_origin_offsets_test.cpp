@@ -31,6 +31,7 @@
 #include "app/render_setup.h"
 #include "app/stability_measure.h"
 #include "common/gltf/writer.h"
+#include "common/math_constants.h"
 #include "common/sampling.h"
 #include "common/surface.h"
 
@@ -188,7 +189,7 @@ ShadowCounts countShadows(const ContactScene& cs, const Scene& scene, const Rend
       const glm::dvec3 n =
           glm::normalize(glm::cross(glm::dvec3(scene.positions[tri.y] - scene.positions[tri.x]),
                                     glm::dvec3(scene.positions[tri.z] - scene.positions[tri.x])));
-      const float expected = float(kAlbedo * kIntensity * glm::dot(n, toLight) / M_PI);
+      const float expected = float(kAlbedo * kIntensity * glm::dot(n, toLight) / kPi);
       const float seen = image.color[i].r;
       if (deepest > kMargin) {
         ++counts.shadowed;
@@ -320,7 +321,7 @@ GltfScene litScene(const glm::dvec3& offset) {
   const glm::dvec3 centre = offset + glm::dvec3(1.5, 1.5, 0.0);
   for (int i = 0; i <= kRings; ++i)
     for (int j = 0; j <= kSegments; ++j) {
-      const double theta = M_PI * i / kRings, phi = 2.0 * M_PI * j / kSegments;
+      const double theta = kPi * i / kRings, phi = 2.0 * kPi * j / kSegments;
       sphere.positions.push_back(
           glm::vec3(centre + 1.5 * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta),
                                               -std::sin(theta) * std::sin(phi))));

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "common/math_constants.h"
+
 namespace rastray::test {
 
 uint64_t SceneRandom::next() {
@@ -77,7 +79,7 @@ GltfMesh fan(SceneRandom& rng) {
   const int k = 3 + rng.below(10);
   m.positions.emplace_back(c + r * glm::dvec3(0.0, 0.0, bump));
   for (int i = 0; i < k; ++i) {
-    const double a = 2.0 * M_PI * i / k;
+    const double a = 2.0 * kPi * i / k;
     m.positions.emplace_back(c + r * glm::dvec3(radius * std::cos(a), radius * std::sin(a), 0.0));
   }
   for (int i = 0; i < k; ++i)

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "common/math_constants.h"
 #include "frames.h"
 
 namespace rastray {
@@ -119,7 +120,7 @@ TEST(Classifier, PerspectiveEdgeProjection) {
   s.instances = {inst};
   s.materials = {Material{}};
   CameraModel cam;
-  cam.yfov = 3.14159265358979323846 / 2.0;
+  cam.yfov = kPi / 2.0;
   cam.znear = 0.5;
   s.camera = cam;
   const Camera camera = makeCamera(s, {}, 8, 8);
