@@ -176,6 +176,186 @@ ImageSpaceEvidence imageSpaceEvidence(const LayeredFrame& fa, const LayeredFrame
   return e;
 }
 
+// Compares two layered frames slot by slot into one report: each slot's
+// front surfaces (the sample) and its layers aligned by (instance,
+// triangle), with depth errors on agreeing layers and the colour of layers
+// one renderer cut off.
+class LayeredComparison {
+ public:
+  LayeredComparison(const LayeredFrame& fa, const LayeredFrame& fb,
+                    const std::vector<glm::dvec2>& slotPositions, const std::vector<int>& slotSamples,
+                    const ClassifierSettings& settings)
+      : fa_(fa), fb_(fb), slotPositions_(slotPositions), slotSamples_(slotSamples), classifier_(settings) {
+    r_.width = fa.width;
+    r_.height = fa.height;
+    r_.geometric = classifier_.geometric();
+    r_.depthFormat = settings.depthFormat;
+    r_.planes = settings.planes;
+    r_.edgeDistance = settings.edgeDistance;
+  }
+
+  VisibilityReport run() {
+    const size_t pixels = size_t(fa_.width) * size_t(fa_.height);
+    r_.pixels.assign(pixels, PixelVisibility::BothEmpty);
+    r_.pixelDepthError.assign(pixels, std::nanf(""));
+    for (int y = 0; y < fa_.height; ++y)
+      for (int x = 0; x < fa_.width; ++x) {
+        const size_t pixel = size_t(y) * size_t(fa_.width) + size_t(x);
+        glm::dvec4 cutOffColor(0.0);  // this pixel's share of colour in cut-off layers
+        for (int s = 0; s < fa_.slots; ++s)
+          compareSlot({x, y, s, pixel, glm::dvec2(x, y) + slotPositions_[size_t(s)]}, cutOffColor);
+        cutOffColor /= double(fa_.slots);
+        const double share = std::max(std::max(std::fabs(cutOffColor.r), std::fabs(cutOffColor.g)),
+                                      std::max(std::fabs(cutOffColor.b), std::fabs(cutOffColor.a)));
+        sumCutOffColor_ += share;
+        if (share > r_.cutOff.maxColor) {
+          r_.cutOff.maxColor = share;
+          r_.cutOff.maxX = x;
+          r_.cutOff.maxY = y;
+        }
+      }
+    if (pixels) r_.cutOff.meanColor = sumCutOffColor_ / double(pixels);
+    if (r_.depth.count) {
+      r_.depth.meanAbsolute = sumAbs_ / double(r_.depth.count);
+      r_.depth.meanRelative = sumRel_ / double(r_.depth.count);
+    }
+    return std::move(r_);
+  }
+
+ private:
+  // Where a pair is compared: pixel (x, y), slot s, the sample position.
+  struct At {
+    int x, y, s;
+    size_t pixel;
+    glm::dvec2 position;
+  };
+
+  // Records one compared pair (a layer, or the sample's front layers) in
+  // `c`; returns its class (none: agreement). `inherited`: the class to
+  // give a mismatch instead of classifying it.
+  std::optional<MismatchClass> record(const At& at, const HitRecord& a, const HitRecord& b, size_t layer,
+                                      AgreementCounts& c, bool isLayer,
+                                      std::optional<MismatchClass> inherited = {}) {
+    PixelVisibility& vis = r_.pixels[at.pixel];
+    ++c.compared;
+    if (a.sameSurface(b)) {
+      ++c.agreeing;
+      c.bothEmpty += !a.isHit();
+      if (!isLayer) return std::nullopt;
+      vis = std::max(vis, a.isHit() ? PixelVisibility::Agree : PixelVisibility::BothEmpty);
+      if (a.isHit() && std::isfinite(a.depth) && std::isfinite(b.depth)) recordDepthError(at, a, b);
+      return std::nullopt;
+    }
+    MismatchClass cls;
+    if (inherited) {
+      cls = *inherited;
+    } else {
+      const ImageSpaceEvidence evidence =
+          classifier_.geometric() ? ImageSpaceEvidence{} : imageSpaceEvidence(fa_, fb_, at.x, at.y, a, b);
+      cls = classifier_.classify(at.position, a, b, evidence);
+    }
+    ++c.mismatches[size_t(cls)];
+    if (!isLayer) return cls;
+    vis = std::max(vis, toPixelVisibility(cls));
+    auto& example = r_.examples[size_t(cls)];
+    if (!example) example = MismatchExample{at.x, at.y, slotSamples_[size_t(at.s)], int(layer), a, b};
+    return cls;
+  }
+
+  void recordDepthError(const At& at, const HitRecord& a, const HitRecord& b) {
+    const double absolute = std::fabs(double(a.depth) - double(b.depth));
+    const double scale = std::max(double(a.depth), double(b.depth));
+    const double relative = scale > 0.0 ? absolute / scale : 0.0;
+    ++r_.depth.count;
+    sumAbs_ += absolute;
+    sumRel_ += relative;
+    if (absolute > r_.depth.maxAbsolute || r_.depth.maxAbsoluteX < 0) {
+      r_.depth.maxAbsolute = absolute;
+      r_.depth.maxAbsoluteX = at.x;
+      r_.depth.maxAbsoluteY = at.y;
+    }
+    r_.depth.maxRelative = std::max(r_.depth.maxRelative, relative);
+    float& pe = r_.pixelDepthError[at.pixel];
+    if (std::isnan(pe) || float(absolute) > pe) pe = float(absolute);
+  }
+
+  // The colour a cut-off layer has in the renderer that reached it: the
+  // layer's own premultiplied colour behind the transmittance in front of it.
+  static glm::dvec4 cutOffLayerColor(const LayeredFrame& full, size_t slot, size_t layer) {
+    if (full.colors.empty()) return glm::dvec4(0.0);
+    const size_t first = full.offsets[slot];
+    double transmittance = 1.0;
+    for (size_t j = 0; j < layer; ++j) transmittance *= 1.0 - double(full.colors[first + j].a);
+    return transmittance * glm::dvec4(full.colors[first + layer]);
+  }
+
+  void compareSlot(const At& at, glm::dvec4& cutOffColor) {
+    const size_t slot = fa_.slot(at.x, at.y, at.s);
+    const HitRecord* la = fa_.begin(slot);
+    const HitRecord* lb = fb_.begin(slot);
+    const HitRecord empty;
+    const size_t na = fa_.layerCount(slot), nb = fb_.layerCount(slot);
+    // The sample: its front surfaces.
+    record(at, na ? la[0] : empty, nb ? lb[0] : empty, 0, r_.samples, false);
+    // The layers, aligned by (instance, triangle): a surface one renderer
+    // missed at an edge must not shift every layer behind it into a false
+    // mismatch. The alignment is a longest common subsequence of the two
+    // front-to-back lists; between matched layers, the unmatched ones are
+    // paired in order, and the rest are compared with nothing.
+    // Layers behind the last one of a renderer that declared a cut-off
+    // there are cut off, not compared (see the header).
+    const auto aligned = alignLayers(la, na, lb, nb);
+    // Alignment entries after the one holding a side's cut-off layer.
+    const uint32_t cutA = fa_.cutOff.empty() ? 0 : fa_.cutOff[slot];
+    const uint32_t cutB = fb_.cutOff.empty() ? 0 : fb_.cutOff[slot];
+    size_t behindA = aligned.size(), behindB = aligned.size();
+    for (size_t k = 0; k < aligned.size(); ++k) {
+      if (cutA && aligned[k].first + 1 == cutA) behindA = k + 1;
+      if (cutB && aligned[k].second + 1 == cutB) behindB = k + 1;
+    }
+    // A list that ends early (its last layer opaque, where the other
+    // renderer saw something else): the other's layers behind that point
+    // were hidden by it, so they share the class of the mismatch at its
+    // last layer (a silhouette one renderer caught and the other missed
+    // hides or reveals everything behind it).
+    size_t endA = aligned.size(), endB = aligned.size();
+    for (size_t k = 0; k < aligned.size(); ++k) {
+      if (na && aligned[k].first + 1 == na) endA = k;
+      if (nb && aligned[k].second + 1 == nb) endB = k;
+    }
+    std::optional<MismatchClass> classAtEndA, classAtEndB;
+    bool sampleCutOff = false;
+    for (size_t k = 0; k < aligned.size(); ++k) {
+      const auto [ia, ib] = aligned[k];
+      const bool cutOffByA = k >= behindA && ia >= na && ib < nb;  // only B has it
+      const bool cutOffByB = k >= behindB && ib >= nb && ia < na;
+      if (cutOffByA || cutOffByB) {
+        ++r_.layers.cutOff;
+        sampleCutOff = true;
+        r_.pixels[at.pixel] = std::max(r_.pixels[at.pixel], PixelVisibility::CutOff);
+        cutOffColor += cutOffByA ? cutOffLayerColor(fb_, slot, ib) : cutOffLayerColor(fa_, slot, ia);
+        continue;
+      }
+      std::optional<MismatchClass> inherited;
+      if (ia >= na && k > endA && classAtEndA != MismatchClass::Genuine) inherited = classAtEndA;
+      if (ib >= nb && k > endB && classAtEndB != MismatchClass::Genuine) inherited = classAtEndB;
+      const auto cls = record(at, ia < na ? la[ia] : empty, ib < nb ? lb[ib] : empty, std::min(ia, ib),
+                              r_.layers, true, inherited);
+      if (k == endA) classAtEndA = cls;
+      if (k == endB) classAtEndB = cls;
+    }
+    r_.cutOff.samples += sampleCutOff;
+  }
+
+  const LayeredFrame& fa_;
+  const LayeredFrame& fb_;
+  const std::vector<glm::dvec2>& slotPositions_;
+  const std::vector<int>& slotSamples_;
+  MismatchClassifier classifier_;
+  VisibilityReport r_;
+  double sumAbs_ = 0.0, sumRel_ = 0.0, sumCutOffColor_ = 0.0;
+};
+
 VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
                                 const std::vector<glm::dvec2>& slotPositions,
                                 const std::vector<int>& slotSamples, const ClassifierSettings& settings,
@@ -184,153 +364,7 @@ VisibilityReport compareLayered(const LayeredFrame& fa, const LayeredFrame& fb,
     checkIds(fa, *settings.scene, names.a);
     checkIds(fb, *settings.scene, names.b);
   }
-  MismatchClassifier classifier(settings);
-  VisibilityReport r;
-  r.width = fa.width;
-  r.height = fa.height;
-  r.geometric = classifier.geometric();
-  r.depthFormat = settings.depthFormat;
-  r.planes = settings.planes;
-  r.edgeDistance = settings.edgeDistance;
-  const size_t pixels = size_t(fa.width) * size_t(fa.height);
-  r.pixels.assign(pixels, PixelVisibility::BothEmpty);
-  r.pixelDepthError.assign(pixels, std::nanf(""));
-  double sumAbs = 0.0, sumRel = 0.0;
-  double sumCutOffColor = 0.0;
-  const HitRecord empty;
-  for (int y = 0; y < fa.height; ++y)
-    for (int x = 0; x < fa.width; ++x) {
-      const size_t pixel = size_t(y) * size_t(fa.width) + size_t(x);
-      PixelVisibility& vis = r.pixels[pixel];
-      glm::dvec4 cutOffColor(0.0);  // this pixel's share of colour in cut-off layers
-      for (int s = 0; s < fa.slots; ++s) {
-        const size_t slot = fa.slot(x, y, s);
-        const HitRecord* la = fa.begin(slot);
-        const HitRecord* lb = fb.begin(slot);
-        const glm::dvec2 position = glm::dvec2(x, y) + slotPositions[size_t(s)];
-        // Records one compared pair (a layer, or the sample's front layers).
-        // Records one compared pair; returns its class (none: agreement).
-        // `inherited`: the class to give a mismatch instead of classifying it.
-        auto record = [&](const HitRecord& a, const HitRecord& b, size_t layer, AgreementCounts& c,
-                          bool isLayer,
-                          std::optional<MismatchClass> inherited = {}) -> std::optional<MismatchClass> {
-          ++c.compared;
-          if (a.sameSurface(b)) {
-            ++c.agreeing;
-            c.bothEmpty += !a.isHit();
-            if (!isLayer) return std::nullopt;
-            vis = std::max(vis, a.isHit() ? PixelVisibility::Agree : PixelVisibility::BothEmpty);
-            if (a.isHit() && std::isfinite(a.depth) && std::isfinite(b.depth)) {
-              const double absolute = std::fabs(double(a.depth) - double(b.depth));
-              const double scale = std::max(double(a.depth), double(b.depth));
-              const double relative = scale > 0.0 ? absolute / scale : 0.0;
-              ++r.depth.count;
-              sumAbs += absolute;
-              sumRel += relative;
-              if (absolute > r.depth.maxAbsolute || r.depth.maxAbsoluteX < 0) {
-                r.depth.maxAbsolute = absolute;
-                r.depth.maxAbsoluteX = x;
-                r.depth.maxAbsoluteY = y;
-              }
-              r.depth.maxRelative = std::max(r.depth.maxRelative, relative);
-              float& pe = r.pixelDepthError[pixel];
-              if (std::isnan(pe) || float(absolute) > pe) pe = float(absolute);
-            }
-            return std::nullopt;
-          }
-          MismatchClass cls;
-          if (inherited) {
-            cls = *inherited;
-          } else {
-            const ImageSpaceEvidence evidence =
-                classifier.geometric() ? ImageSpaceEvidence{} : imageSpaceEvidence(fa, fb, x, y, a, b);
-            cls = classifier.classify(position, a, b, evidence);
-          }
-          ++c.mismatches[size_t(cls)];
-          if (!isLayer) return cls;
-          vis = std::max(vis, toPixelVisibility(cls));
-          auto& example = r.examples[size_t(cls)];
-          if (!example) example = MismatchExample{x, y, slotSamples[size_t(s)], int(layer), a, b};
-          return cls;
-        };
-        const size_t na = fa.layerCount(slot), nb = fb.layerCount(slot);
-        // The sample: its front surfaces.
-        record(na ? la[0] : empty, nb ? lb[0] : empty, 0, r.samples, false);
-        // The layers, aligned by (instance, triangle): a surface one
-        // renderer missed at an edge must not shift every layer behind it
-        // into a false mismatch. The alignment is a longest common
-        // subsequence of the two front-to-back lists; between matched
-        // layers, the unmatched ones are paired in order, and the rest are
-        // compared with nothing.
-        // Layers behind the last one of a renderer that declared a cut-off
-        // there are cut off, not compared (see the header).
-        const auto aligned = alignLayers(la, na, lb, nb);
-        // Alignment entries after the one holding a side's cut-off layer.
-        const uint32_t cutA = fa.cutOff.empty() ? 0 : fa.cutOff[slot];
-        const uint32_t cutB = fb.cutOff.empty() ? 0 : fb.cutOff[slot];
-        size_t behindA = aligned.size(), behindB = aligned.size();
-        for (size_t k = 0; k < aligned.size(); ++k) {
-          if (cutA && aligned[k].first + 1 == cutA) behindA = k + 1;
-          if (cutB && aligned[k].second + 1 == cutB) behindB = k + 1;
-        }
-        // A list that ends early (its last layer opaque, where the other
-        // renderer saw something else): the other's layers behind that
-        // point were hidden by it, so they share the class of the mismatch
-        // at its last layer (a silhouette one renderer caught and the other
-        // missed hides or reveals everything behind it).
-        size_t endA = aligned.size(), endB = aligned.size();
-        for (size_t k = 0; k < aligned.size(); ++k) {
-          if (na && aligned[k].first + 1 == na) endA = k;
-          if (nb && aligned[k].second + 1 == nb) endB = k;
-        }
-        std::optional<MismatchClass> classAtEndA, classAtEndB;
-        bool sampleCutOff = false;
-        for (size_t k = 0; k < aligned.size(); ++k) {
-          const auto [ia, ib] = aligned[k];
-          const bool cutOffByA = k >= behindA && ia >= na && ib < nb;  // only B has it
-          const bool cutOffByB = k >= behindB && ib >= nb && ia < na;
-          if (cutOffByA || cutOffByB) {
-            ++r.layers.cutOff;
-            sampleCutOff = true;
-            vis = std::max(vis, PixelVisibility::CutOff);
-            // Its colour in the renderer that reached it: the layer's own
-            // premultiplied colour behind the transmittance in front of it.
-            const LayeredFrame& full = cutOffByA ? fb : fa;
-            const size_t layer = cutOffByA ? ib : ia;
-            if (!full.colors.empty()) {
-              const size_t first = full.offsets[slot];
-              double transmittance = 1.0;
-              for (size_t j = 0; j < layer; ++j) transmittance *= 1.0 - double(full.colors[first + j].a);
-              cutOffColor += transmittance * glm::dvec4(full.colors[first + layer]);
-            }
-            continue;
-          }
-          std::optional<MismatchClass> inherited;
-          if (ia >= na && k > endA && classAtEndA != MismatchClass::Genuine) inherited = classAtEndA;
-          if (ib >= nb && k > endB && classAtEndB != MismatchClass::Genuine) inherited = classAtEndB;
-          const auto cls = record(ia < na ? la[ia] : empty, ib < nb ? lb[ib] : empty, std::min(ia, ib),
-                                  r.layers, true, inherited);
-          if (k == endA) classAtEndA = cls;
-          if (k == endB) classAtEndB = cls;
-        }
-        r.cutOff.samples += sampleCutOff;
-      }
-      cutOffColor /= double(fa.slots);
-      const double share = std::max(std::max(std::fabs(cutOffColor.r), std::fabs(cutOffColor.g)),
-                                    std::max(std::fabs(cutOffColor.b), std::fabs(cutOffColor.a)));
-      sumCutOffColor += share;
-      if (share > r.cutOff.maxColor) {
-        r.cutOff.maxColor = share;
-        r.cutOff.maxX = x;
-        r.cutOff.maxY = y;
-      }
-    }
-  if (pixels) r.cutOff.meanColor = sumCutOffColor / double(pixels);
-  if (r.depth.count) {
-    r.depth.meanAbsolute = sumAbs / double(r.depth.count);
-    r.depth.meanRelative = sumRel / double(r.depth.count);
-  }
-  return r;
+  return LayeredComparison(fa, fb, slotPositions, slotSamples, settings).run();
 }
 
 void checkSpp(int spp) {
