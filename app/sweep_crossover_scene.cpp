@@ -4,11 +4,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/math_constants.h"
+
 namespace rastray::crossover {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kAmplitude = 0.06, kWavelength = 0.5;
 constexpr double kYfov = 0.8;  // radians
 // Screen margin beyond the image on each side, as a fraction of its width
