@@ -289,48 +289,22 @@ std::vector<std::size_t> paretoFront(const std::vector<PlotPoint>& points) {
   return front;
 }
 
-PlotRender renderPlot(const Plot& plot) {
-  PlotRender out;
-  const double W = std::max(plot.width, 200), H = std::max(plot.height, 150);
-  const double font = 13, small = 11;
+namespace {
 
-  const Range rx = dataRange(plot, plot.x, true), ry = dataRange(plot, plot.y, false);
-  const AxisTicks tx = axisTicks(plot.x, rx), ty = axisTicks(plot.y, ry);
+// The frame of one plot: sizes, the plot area, ticks and the data→SVG maps.
+struct PlotFrame {
+  double font = 13, small = 11;
+  double ax0 = 0, ax1 = 0, ay0 = 0, ay1 = 0, width = 0, height = 0;
+  AxisTicks tx, ty;
+  AxisMap mx, my;
+};
 
-  // Layout: title on top, y labels and title on the left, x labels and title
-  // below, the legend in a column on the right.
-  double yLabelWidth = 0;
-  for (const std::string& l : ty.labels) yLabelWidth = std::max(yLabelWidth, textWidth(l, small));
-  double legendWidth = 0;
-  for (const PlotSeries& s : plot.series) legendWidth = std::max(legendWidth, textWidth(s.name, small));
-  legendWidth = plot.series.empty() ? 0 : std::min(legendWidth + 40, W * 0.35);
-  const double left = 14 + font + 8 + yLabelWidth + 8;
-  const double top = plot.title.empty() ? 16 : 16 + font * 1.4 + 8;
-  const double right = 16 + legendWidth;
-  const double bottom = 8 + small + 10 + font + 22;  // tick labels, axis title, skipped note
-  out.areaX = left;
-  out.areaY = top;
-  out.areaWidth = std::max(40.0, W - left - right);
-  out.areaHeight = std::max(40.0, H - top - bottom);
-  const double ax0 = out.areaX, ax1 = out.areaX + out.areaWidth;
-  const double ay0 = out.areaY, ay1 = out.areaY + out.areaHeight;
-
-  const AxisMap mx{plot.x.scale, tx.lo, tx.hi, ax0, ax1};
-  const AxisMap my{plot.y.scale, ty.lo, ty.hi, ay1, ay0};
-
-  std::string s;
-  s += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + num(W) + "\" height=\"" + num(H) +
-       "\" viewBox=\"0 0 " + num(W) + " " + num(H) +
-       "\" font-family=\"sans-serif\" style=\"max-width:100%;height:auto\" role=\"img\">\n";
-  s += "<title>" +
-       escapeXml(plot.title.empty() ? axisTitle(plot.y) + " against " + axisTitle(plot.x) : plot.title) +
-       "</title>\n";
-  s += "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
-  if (!plot.title.empty())
-    s += "<text x=\"" + num(ax0 + out.areaWidth / 2) + "\" y=\"" + num(16 + font) +
-         "\" text-anchor=\"middle\" font-size=\"" + num(font * 1.2) + "\" font-weight=\"bold\">" +
-         escapeXml(plot.title) + "</text>\n";
-
+// Grid, plot area, ticks, tick labels and axis titles.
+void appendAxes(std::string& s, const Plot& plot, const PlotFrame& f) {
+  const double font = f.font, small = f.small;
+  const double ax0 = f.ax0, ax1 = f.ax1, ay0 = f.ay0, ay1 = f.ay1;
+  const AxisTicks &tx = f.tx, &ty = f.ty;
+  const AxisMap &mx = f.mx, &my = f.my;
   // Grid and ticks: minor ticks light, major ticks with a grid line and label.
   s += "<g class=\"grid\" stroke=\"#e4e4e4\" stroke-width=\"1\">\n";
   for (double v : tx.major)
@@ -342,9 +316,8 @@ PlotRender renderPlot(const Plot& plot) {
       s += "<line x1=\"" + num(ax0) + "\" y1=\"" + num(my(v)) + "\" x2=\"" + num(ax1) + "\" y2=\"" +
            num(my(v)) + "\"/>\n";
   s += "</g>\n";
-  s += "<rect class=\"plot-area\" x=\"" + num(out.areaX) + "\" y=\"" + num(out.areaY) + "\" width=\"" +
-       num(out.areaWidth) + "\" height=\"" + num(out.areaHeight) +
-       "\" fill=\"none\" stroke=\"#333333\" stroke-width=\"1\"/>\n";
+  s += "<rect class=\"plot-area\" x=\"" + num(f.ax0) + "\" y=\"" + num(f.ay0) + "\" width=\"" + num(f.width) +
+       "\" height=\"" + num(f.height) + "\" fill=\"none\" stroke=\"#333333\" stroke-width=\"1\"/>\n";
   s += "<g class=\"ticks\" stroke=\"#333333\" stroke-width=\"1\">\n";
   for (double v : tx.minor)
     if (mx.drawable(v))
@@ -375,14 +348,21 @@ PlotRender renderPlot(const Plot& plot) {
       s += "<text x=\"" + num(ax0 - 9) + "\" y=\"" + num(my(ty.major[i]) + small * 0.35) + "\">" +
            labelSvg(ty.labels[i], plot.y.scale) + "</text>\n";
   s += "</g>\n";
-  s += "<text class=\"x-title\" x=\"" + num(ax0 + out.areaWidth / 2) + "\" y=\"" +
+  s += "<text class=\"x-title\" x=\"" + num(ax0 + f.width / 2) + "\" y=\"" +
        num(ay1 + 8 + small + 10 + font) + "\" text-anchor=\"middle\" font-size=\"" + num(font) + "\">" +
        escapeXml(axisTitle(plot.x)) + "</text>\n";
-  const double yTitleX = 14 + font * 0.8, yTitleY = ay0 + out.areaHeight / 2;
+  const double yTitleX = 14 + font * 0.8, yTitleY = ay0 + f.height / 2;
   s += "<text class=\"y-title\" x=\"" + num(yTitleX) + "\" y=\"" + num(yTitleY) +
        "\" text-anchor=\"middle\" font-size=\"" + num(font) + "\" transform=\"rotate(-90 " + num(yTitleX) +
        " " + num(yTitleY) + ")\">" + escapeXml(axisTitle(plot.y)) + "</text>\n";
+}
 
+// Every series' line, markers, tooltips and point texts, clipped to the
+// plot area; counts what was drawn and skipped into `out`.
+void appendSeries(std::string& s, const Plot& plot, const PlotFrame& f, PlotRender& out) {
+  const double small = f.small;
+  const double ax0 = f.ax0, ax1 = f.ax1, ay0 = f.ay0;
+  const AxisMap &mx = f.mx, &my = f.my;
   // Data, clipped by a nested <svg> (no clipPath id needed) whose viewBox
   // equals its box, so coordinates are those of the whole plot. Every point
   // drawn lies in the plot area and so do the lines between them; the clip,
@@ -394,9 +374,9 @@ PlotRender renderPlot(const Plot& plot) {
   const std::vector<std::string>& palette = plotPalette();
   const double pad = 8;
   const std::string box = num(ax0 - pad) + "\" y=\"" + num(ay0 - pad) + "\" width=\"" +
-                          num(out.areaWidth + 2 * pad) + "\" height=\"" + num(out.areaHeight + 2 * pad);
+                          num(f.width + 2 * pad) + "\" height=\"" + num(f.height + 2 * pad);
   s += "<svg class=\"data\" x=\"" + box + "\" viewBox=\"" + num(ax0 - pad) + " " + num(ay0 - pad) + " " +
-       num(out.areaWidth + 2 * pad) + " " + num(out.areaHeight + 2 * pad) + "\" overflow=\"hidden\">\n";
+       num(f.width + 2 * pad) + " " + num(f.height + 2 * pad) + "\" overflow=\"hidden\">\n";
   for (std::size_t si : order) {
     const PlotSeries& ser = plot.series[si];
     const std::string colour =
@@ -461,7 +441,8 @@ PlotRender renderPlot(const Plot& plot) {
         // Right of the marker, or left of it when it would run past the plot area.
         const bool toLeft = px[i] + radius + 3 + textWidth(p.text, small) > ax1;
         s += "<text x=\"" + num(toLeft ? px[i] - radius - 3 : px[i] + radius + 3) + "\" y=\"" +
-             num(py[i] - radius - 2) + "\" font-size=\"" + num(small) + (toLeft ? "\" text-anchor=\"end" : "") +
+             num(py[i] - radius - 2) + "\" font-size=\"" + num(small) +
+             (toLeft ? "\" text-anchor=\"end" : "") +
              "\" fill=\"#222222\" stroke=\"#ffffff\" stroke-width=\"3\" paint-order=\"stroke\">" +
              escapeXml(p.text) + "</text>\n";
       }
@@ -469,7 +450,13 @@ PlotRender renderPlot(const Plot& plot) {
     s += "</g>\n";
   }
   s += "</svg>\n";
+}
 
+// The legend column right of the plot area.
+void appendLegend(std::string& s, const Plot& plot, const PlotFrame& f) {
+  const double small = f.small;
+  const double ax1 = f.ax1, ay0 = f.ay0;
+  const std::vector<std::string>& palette = plotPalette();
   // Legend: a line and marker sample per series, in the given order.
   if (!plot.series.empty()) {
     const double lx = ax1 + 14, ly = ay0 + 4;
@@ -495,6 +482,56 @@ PlotRender renderPlot(const Plot& plot) {
     }
     s += "</g>\n";
   }
+}
+
+}  // namespace
+
+PlotRender renderPlot(const Plot& plot) {
+  PlotRender out;
+  const double W = std::max(plot.width, 200), H = std::max(plot.height, 150);
+  const double font = 13, small = 11;
+
+  const Range rx = dataRange(plot, plot.x, true), ry = dataRange(plot, plot.y, false);
+  const AxisTicks tx = axisTicks(plot.x, rx), ty = axisTicks(plot.y, ry);
+
+  // Layout: title on top, y labels and title on the left, x labels and title
+  // below, the legend in a column on the right.
+  double yLabelWidth = 0;
+  for (const std::string& l : ty.labels) yLabelWidth = std::max(yLabelWidth, textWidth(l, small));
+  double legendWidth = 0;
+  for (const PlotSeries& s : plot.series) legendWidth = std::max(legendWidth, textWidth(s.name, small));
+  legendWidth = plot.series.empty() ? 0 : std::min(legendWidth + 40, W * 0.35);
+  const double left = 14 + font + 8 + yLabelWidth + 8;
+  const double top = plot.title.empty() ? 16 : 16 + font * 1.4 + 8;
+  const double right = 16 + legendWidth;
+  const double bottom = 8 + small + 10 + font + 22;  // tick labels, axis title, skipped note
+  out.areaX = left;
+  out.areaY = top;
+  out.areaWidth = std::max(40.0, W - left - right);
+  out.areaHeight = std::max(40.0, H - top - bottom);
+  const double ax0 = out.areaX, ax1 = out.areaX + out.areaWidth;
+  const double ay0 = out.areaY, ay1 = out.areaY + out.areaHeight;
+
+  const AxisMap mx{plot.x.scale, tx.lo, tx.hi, ax0, ax1};
+  const AxisMap my{plot.y.scale, ty.lo, ty.hi, ay1, ay0};
+  const PlotFrame frame{font, small, ax0, ax1, ay0, ay1, out.areaWidth, out.areaHeight, tx, ty, mx, my};
+
+  std::string s;
+  s += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + num(W) + "\" height=\"" + num(H) +
+       "\" viewBox=\"0 0 " + num(W) + " " + num(H) +
+       "\" font-family=\"sans-serif\" style=\"max-width:100%;height:auto\" role=\"img\">\n";
+  s += "<title>" +
+       escapeXml(plot.title.empty() ? axisTitle(plot.y) + " against " + axisTitle(plot.x) : plot.title) +
+       "</title>\n";
+  s += "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
+  if (!plot.title.empty())
+    s += "<text x=\"" + num(ax0 + out.areaWidth / 2) + "\" y=\"" + num(16 + font) +
+         "\" text-anchor=\"middle\" font-size=\"" + num(font * 1.2) + "\" font-weight=\"bold\">" +
+         escapeXml(plot.title) + "</text>\n";
+
+  appendAxes(s, plot, frame);
+  appendSeries(s, plot, frame, out);
+  appendLegend(s, plot, frame);
 
   if (out.skipped > 0)
     s += "<text class=\"skipped\" x=\"" + num(ax0) + "\" y=\"" + num(H - 6) + "\" font-size=\"" + num(small) +

@@ -190,8 +190,9 @@ TEST(Explain, JsonHasTheSameEventsAsTheText) {
     const std::string stage = e.at("stage");
     EXPECT_EQ(rasterLines[i].find_first_not_of(' '), 2 * e.at("depth").get<size_t>()) << rasterLines[i];
     EXPECT_EQ(rasterLines[i].substr(rasterLines[i].find_first_not_of(' '), stage.size()), stage);
-    if (!e.at("outcome").get<std::string>().empty())
+    if (!e.at("outcome").get<std::string>().empty()) {
       EXPECT_NE(rasterLines[i].find(" -> " + e.at("outcome").get<std::string>()), std::string::npos);
+    }
     for (const auto& [name, value] : e.at("values").items())
       EXPECT_NE(rasterLines[i].find(" " + name + " " + value.get<std::string>()), std::string::npos)
           << rasterLines[i];

@@ -1,6 +1,8 @@
 // Helpers for the raster tests: scenes built in code and cameras.
 #pragma once
 
+#include "common/math_constants.h"
+
 #include <glm/glm.hpp>
 #include <string>
 #include <vector>
@@ -64,7 +66,7 @@ inline Camera perspectiveCamera(int w, int h, double yfovRadians, glm::dvec3 eye
   o.eye = eye;
   o.target = target;
   o.up = glm::dvec3(0, 1, 0);
-  o.yfovDegrees = yfovRadians * 180.0 / 3.14159265358979323846;
+  o.yfovDegrees = yfovRadians * 180.0 / kPi;
   o.znear = znear;
   o.zfar = zfar;
   return makeCamera(empty, o, w, h);
@@ -77,9 +79,9 @@ inline void addSphere(Scene& scene, glm::dvec3 centre, double radius, int slices
   std::vector<glm::uvec3> t;
   p.push_back(glm::vec3(centre + glm::dvec3(0, radius, 0)));
   for (int i = 1; i < stacks; ++i) {
-    const double th = 3.14159265358979323846 * i / stacks;
+    const double th = kPi * i / stacks;
     for (int j = 0; j < slices; ++j) {
-      const double ph = 2.0 * 3.14159265358979323846 * j / slices;
+      const double ph = 2.0 * kPi * j / slices;
       p.push_back(glm::vec3(centre + radius * glm::dvec3(std::sin(th) * std::cos(ph), std::cos(th),
                                                          -std::sin(th) * std::sin(ph))));
     }

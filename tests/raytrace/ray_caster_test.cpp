@@ -5,6 +5,8 @@
 #include "raytrace/ray_caster.h"
 
 #include <gtest/gtest.h>
+
+#include "common/math_constants.h"
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -402,7 +404,7 @@ TEST(Grazing, NoNanOrInfOnGrazingRays) {
     b.addQuad({0, 0, 0}, {0, 0, 5}, {5, 0, 0}, white);  // y = 0, front +y
     b.addQuad({0, 0.5, -3}, {0, 0, 1}, {1, 0, 0}, mirrorId);
     b.addBox({0.5f, 0.0f, -2.0f}, {1.0f, 0.5f, -1.5f}, glass);
-    const double a = lightAngle * 3.14159265358979323846 / 180.0;
+    const double a = lightAngle * kPi / 180.0;
     b.addDirectionalLight({std::sin(a), -std::cos(a), 0.0}, 3.0f);
     b.setCamera(Projection::Perspective, {0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 0.8, 0.01, 100.0);
     RayOptions options;
@@ -525,7 +527,9 @@ TEST(DebugPixel, RayTreeOfAGlassPixel) {
     EXPECT_EQ(e.depth, r.kind == RayKind::Shadow ? r.depth + 1 : r.depth);
     ASSERT_FALSE(e.values.empty());
     EXPECT_EQ(e.values.front(), std::make_pair(std::string("kind"), std::string(toString(r.kind))));
-    if (r.kind != RayKind::Shadow) EXPECT_EQ(e.outcome, r.instance == kNoId ? "miss" : "hit");
+    if (r.kind != RayKind::Shadow) {
+      EXPECT_EQ(e.outcome, r.instance == kNoId ? "miss" : "hit");
+    }
   }
   EXPECT_EQ(events.front().outcome, "hit");
   // A pixel outside the image is refused, not ignored.

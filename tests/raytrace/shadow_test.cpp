@@ -2,6 +2,8 @@
 // a directional light's shadow edge where geometry puts it.
 #include <gtest/gtest.h>
 
+#include "common/math_constants.h"
+
 #include <cmath>
 
 #include "raytrace/ray_caster.h"
@@ -11,7 +13,6 @@
 namespace rastray {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 TEST(RayOffset, MovesByUlpsAlongTheNormalAndScalesWithMagnitude) {
   const glm::vec3 n(0.0f, 1.0f, 0.0f);
