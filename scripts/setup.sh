@@ -10,6 +10,7 @@ packages=(
   libembree-dev libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenimageio-dev openimageio-tools libopencv-core-dev libopenexr-dev
   libtbb-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+  chromium  # the real-browser report test (headless), which CI must run, not skip
 )
 
 missing=()
