@@ -6,32 +6,13 @@
 
 #include "common/error.h"
 #include "common/image.h"
+#include "app/svg_plot.h"
 #include "compare/maps.h"
 
 namespace rastray {
 
-std::string escapeHtml(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+// XML escaping (app/svg_plot) is valid HTML text and attribute escaping.
+std::string escapeHtml(const std::string& s) { return escapeXml(s); }
 
 namespace {
 

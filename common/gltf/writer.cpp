@@ -10,6 +10,8 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include "common/math_constants.h"
+
 namespace rastray {
 
 namespace {
@@ -243,6 +245,25 @@ void GltfScene::writeGlb(const std::string& path) const {
   const char zeros[3] = {0, 0, 0};
   out.write(zeros, std::streamsize(binPadded - bytes.size()));
   if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+GltfMesh uvSphereMesh(glm::vec3 centre, float radius, int rings, int segments, int material) {
+  GltfMesh m;
+  m.material = material;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const double theta = kPi * r / rings, phi = 2.0 * kPi * s / segments;
+      m.positions.push_back(centre + radius * glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                                        std::sin(theta) * std::sin(phi)));
+    }
+  auto at = [&](int r, int s) { return uint32_t(r * segments + (s % segments)); };
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const uint32_t a = at(r, s), b = at(r, s + 1), c = at(r + 1, s), d = at(r + 1, s + 1);
+      if (r > 0) m.indices.insert(m.indices.end(), {a, b, c});
+      if (r + 1 < rings) m.indices.insert(m.indices.end(), {b, d, c});
+    }
+  return m;
 }
 
 }  // namespace rastray

@@ -84,4 +84,9 @@ struct GltfScene {
 // major 4×4 matrix as glTF's "matrix".
 std::vector<double> lookAtNodeMatrix(const glm::dvec3& eye, const glm::dvec3& forward, glm::dvec3 up);
 
+// A closed UV sphere (rings × segments, pole fans without degenerate
+// triangles), counter-clockwise seen from outside, with flat normals (no
+// NORMAL attribute).
+GltfMesh uvSphereMesh(glm::vec3 centre, float radius, int rings, int segments, int material);
+
 }  // namespace rastray

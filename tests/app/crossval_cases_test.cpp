@@ -44,26 +44,6 @@ GltfMesh quad(glm::vec3 centre, float half, int material) {
   return m;
 }
 
-// A closed UV sphere, outward-facing (CCW seen from outside).
-GltfMesh sphere(glm::vec3 centre, float radius, int rings, int segments, int material) {
-  GltfMesh m;
-  m.material = material;
-  for (int r = 0; r <= rings; ++r)
-    for (int s = 0; s < segments; ++s) {
-      const double theta = glm::pi<double>() * r / rings, phi = 2.0 * glm::pi<double>() * s / segments;
-      m.positions.push_back(centre + radius * glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                                        std::sin(theta) * std::sin(phi)));
-    }
-  auto at = [&](int r, int s) { return uint32_t(r * segments + (s % segments)); };
-  for (int r = 0; r < rings; ++r)
-    for (int s = 0; s < segments; ++s) {
-      const uint32_t a = at(r, s), b = at(r, s + 1), c = at(r + 1, s), d = at(r + 1, s + 1);
-      if (r > 0) m.indices.insert(m.indices.end(), {a, b, c});
-      if (r + 1 < rings) m.indices.insert(m.indices.end(), {b, d, c});
-    }
-  return m;
-}
-
 uint64_t genuine(const json& s, const char* pair) {
   return s[pair]["visibility"]["mismatches"]["genuine"].get<uint64_t>();
 }
@@ -163,8 +143,8 @@ TEST(CrossvalCases, CullingAgreesOnClosedSingleSidedMeshes) {
   red.baseColor = glm::vec4(1.0f, 0.2f, 0.2f, 1.0f);
   twoSided.doubleSided = true;
   scene.materials = {grey, red, twoSided};
-  scene.meshes.push_back(sphere(glm::vec3(-0.6f, 0.0f, 0.0f), 0.5f, 24, 48, 0));
-  scene.meshes.push_back(sphere(glm::vec3(0.6f, 0.1f, -0.3f), 0.6f, 20, 40, 1));
+  scene.meshes.push_back(uvSphereMesh(glm::vec3(-0.6f, 0.0f, 0.0f), 0.5f, 24, 48, 0));
+  scene.meshes.push_back(uvSphereMesh(glm::vec3(0.6f, 0.1f, -0.3f), 0.6f, 20, 40, 1));
   GltfMesh wall = quad(glm::vec3(0.0f, 0.0f, -1.5f), 3.0f, 2);
   scene.meshes.push_back(wall);
   scene.lights.push_back({"directional", {0.0, 0.0, 0.0}, {-0.3, -0.5, -1.0}, 3.0f});
