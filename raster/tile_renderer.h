@@ -122,6 +122,11 @@ class TileRenderer {
                        const DepthTarget& target, CoverageScratch& scratch, ThreadCounters& n, F&& f) const;
   BlendLayer shadeLayer(const TileSampleIndex& index, const BlendFragment& f, uint32_t rank,
                         ThreadCounters& n) const;
+  // Shades fragments grouped by sample, each group front to back; a
+  // fragment's rank is its position within its sample's group.
+  std::vector<BlendLayer> shadeInSampleOrder(const TileSampleIndex& index,
+                                             const std::vector<BlendFragment>& fragments,
+                                             ThreadCounters& n) const;
   std::vector<BlendLayer> exactLayers(const TileSampleIndex& index, const std::vector<uint32_t>& bin,
                                       const DepthTarget& target, ThreadCounters& n) const;
   std::vector<BlendLayer> sortedLayers(const TileSampleIndex& index, const std::vector<uint32_t>& bin,

@@ -69,7 +69,14 @@ std::vector<BlendLayer> TileRenderer::exactLayers(const TileSampleIndex& index,
     if (a.planeDepth != b.planeDepth) return a.planeDepth < b.planeDepth;
     return a.id < b.id;
   });
+  return shadeInSampleOrder(index, fragments, n);
+}
+
+std::vector<BlendLayer> TileRenderer::shadeInSampleOrder(const TileSampleIndex& index,
+                                                         const std::vector<BlendFragment>& fragments,
+                                                         ThreadCounters& n) const {
   std::vector<BlendLayer> layers;
+  layers.reserve(fragments.size());
   uint32_t rank = 0;
   for (size_t i = 0; i < fragments.size(); ++i) {
     rank = (i > 0 && fragments[i].local == fragments[i - 1].local) ? rank + 1 : 0;
@@ -110,13 +117,7 @@ std::vector<BlendLayer> TileRenderer::sortedLayers(const TileSampleIndex& index,
     if (a.local != b.local) return a.local < b.local;
     return a.order > b.order;
   });
-  std::vector<BlendLayer> layers;
-  uint32_t rank = 0;
-  for (size_t i = 0; i < fragments.size(); ++i) {
-    rank = (i > 0 && fragments[i].local == fragments[i - 1].local) ? rank + 1 : 0;
-    layers.push_back(shadeLayer(index, fragments[i], rank, n));
-  }
-  return layers;
+  return shadeInSampleOrder(index, fragments, n);
 }
 
 // Depth peeling: pass k keeps, per sample, the nearest fragment behind the
