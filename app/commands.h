@@ -17,5 +17,6 @@ CommandRunner addExplainCommand(CLI::App& app);
 CommandRunner addCompareCommand(CLI::App& app);
 CommandRunner addStabilityCommand(CLI::App& app);
 CommandRunner addSweepCommand(CLI::App& app);
+CommandRunner addBenchCommand(CLI::App& app);
 
 }  // namespace rastray

@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   commands.push_back(addExplainCommand(app));
   commands.push_back(addStabilityCommand(app));
   commands.push_back(addSweepCommand(app));
+  commands.push_back(addBenchCommand(app));
 #endif
   commands.push_back(addCompareCommand(app));
 

@@ -346,16 +346,49 @@ std::string rayTreeText(const std::vector<TraceEvent>& events, glm::ivec2 pixel)
          "): " + std::to_string(rays) + " rays\n" + traceText(events);
 }
 
+FrameRenderer::FrameRenderer(const Scene& scene, const RenderSettings& s, const RasterOptions& raster,
+                             const RayOptions& ray)
+    : scene_(scene),
+      renderer_(s.renderer),
+      raster_(raster),
+      ray_(ray),
+      analysis_(analyzeScene(scene)),
+      camera_(makeCamera(scene, s.camera.overrides(), s.camera.width(), s.camera.height())) {
+  if (renderer_ == RendererKind::Raster) return;
+  const auto start = std::chrono::steady_clock::now();
+  caster_ = std::make_unique<RayCaster>(scene, analysis_, raster.cull);
+  bvhBuildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+FrameRenderer::~FrameRenderer() = default;
+
+RenderOutput FrameRenderer::frame() {
+  // Binding restarts the ray counters, so each frame reports its own rays.
+  if (caster_) caster_->bind(camera_, ray_);
+  switch (renderer_) {
+    case RendererKind::Raster:
+      return renderRaster(scene_, analysis_, camera_, raster_);
+    case RendererKind::Raytrace:
+      return caster_->render();
+    case RendererKind::Hybrid: {
+      const bool traced = raster_.shadows == ShadowMode::Rays;
+      RenderOutput output =
+          renderRaster(scene_, analysis_, camera_, raster_, caster_.get(), traced ? caster_.get() : nullptr);
+      caster_->throwIfError();  // an Embree error in the rays the rasterizer's shading traced
+      output.counters.merge(caster_->counters());
+      return output;
+    }
+  }
+  return {};
+}
+
 RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
-  RenderRun run;
-  run.analysis = analyzeScene(scene);
-  run.camera = makeCamera(scene, s.camera.overrides(), s.camera.width(), s.camera.height());
   RasterOptions raster = s.raster;
   RayOptions ray = s.ray;
   raster.keepSamples = ray.keepSamples = s.keepSamples;
-  if (run.camera.width > 0 && s.debugPixel &&
-      (s.debugPixel->x < 0 || s.debugPixel->y < 0 || s.debugPixel->x >= run.camera.width ||
-       s.debugPixel->y >= run.camera.height))
+  const glm::ivec2 size(s.camera.width(), s.camera.height());
+  if (s.debugPixel &&
+      (s.debugPixel->x < 0 || s.debugPixel->y < 0 || s.debugPixel->x >= size.x || s.debugPixel->y >= size.y))
     badOption("--debug-pixel", "pixel lies outside the image");
   // --debug-pixel without a caller's sink: the rasterizer records into this
   // log, printed to stderr after the render (the libraries never print).
@@ -365,37 +398,16 @@ RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
   if (s.debugPixel && !ray.trace.sink) ray.trace = {&rayTrace, *s.debugPixel};
 
   const auto start = std::chrono::steady_clock::now();
-  const auto secondsSince = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-  };
-  double bvhBuild = -1.0;  // seconds; negative: no ray caster
-  switch (s.renderer) {
-    case RendererKind::Raster:
-      run.output = renderRaster(scene, run.analysis, run.camera, raster);
-      break;
-    case RendererKind::Raytrace: {
-      RayCaster caster(scene, run.analysis, raster.cull);
-      bvhBuild = secondsSince(start);
-      caster.bind(run.camera, ray);
-      run.output = caster.render();
-      break;
-    }
-    case RendererKind::Hybrid: {
-      RayCaster caster(scene, run.analysis, raster.cull);
-      bvhBuild = secondsSince(start);
-      caster.bind(run.camera, ray);
-      const bool traced = raster.shadows == ShadowMode::Rays;
-      run.output = renderRaster(scene, run.analysis, run.camera, raster, &caster, traced ? &caster : nullptr);
-      caster.throwIfError();  // an Embree error in the rays the rasterizer's shading traced
-      run.output.counters.merge(caster.counters());
-      break;
-    }
-  }
+  FrameRenderer renderer(scene, s, raster, ray);
+  RenderRun run;
+  run.camera = renderer.camera();
+  run.analysis = renderer.analysis();
+  run.output = renderer.frame();
   // The Embree scene (BVH) is built once per scene, whatever the camera:
   // reported apart so a sweep can tell it from the frame's own work.
-  if (bvhBuild >= 0.0)
-    run.output.timings.insert(run.output.timings.begin(), {"raytrace.bvh_build", bvhBuild});
-  run.seconds = secondsSince(start);
+  if (renderer.bvhBuildSeconds() >= 0.0)
+    run.output.timings.insert(run.output.timings.begin(), {"raytrace.bvh_build", renderer.bvhBuildSeconds()});
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (raster.trace.sink == &rasterTrace) std::fputs(rasterTrace.text().c_str(), stderr);
   if (ray.trace.sink == &rayTrace) std::fputs(rayTreeText(rayTrace.events(), *s.debugPixel).c_str(), stderr);
   return run;

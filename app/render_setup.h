@@ -4,6 +4,7 @@
 // raytrace/, neither knows the other).
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -103,6 +104,40 @@ struct RenderSettings {
 // Registers --renderer (when `withRenderer`; crossval and explain run every
 // renderer), the camera options and every row of renderOptionTable().
 void addRenderSettings(CLI::App& cmd, RenderSettings& settings, bool withRenderer = true);
+
+// A scene made ready for frames under fixed settings: its analysis, the
+// camera and, for the ray caster and hybrid, the Embree scene (BVH), built
+// once here. frame() renders one frame; calling it again renders the same
+// frame again without rebuilding anything (what `bench` times). The scene
+// and the options must outlive it.
+class FrameRenderer {
+ public:
+  // settings.finish() must have been called; `raster` and `ray` are the
+  // options the renderers run with (settings' own, plus keepSamples and
+  // trace requests the caller set); they must outlive this object.
+  FrameRenderer(const Scene& scene, const RenderSettings& settings, const RasterOptions& raster,
+                const RayOptions& ray);
+  ~FrameRenderer();
+  FrameRenderer(const FrameRenderer&) = delete;
+  FrameRenderer& operator=(const FrameRenderer&) = delete;
+
+  RenderOutput frame();
+
+  const Camera& camera() const { return camera_; }
+  const SceneAnalysis& analysis() const { return analysis_; }
+  // Seconds the Embree scene took to build; negative without a ray caster.
+  double bvhBuildSeconds() const { return bvhBuildSeconds_; }
+
+ private:
+  const Scene& scene_;
+  RendererKind renderer_;
+  const RasterOptions& raster_;
+  const RayOptions& ray_;
+  SceneAnalysis analysis_;
+  Camera camera_;
+  std::unique_ptr<RayCaster> caster_;
+  double bvhBuildSeconds_ = -1.0;
+};
 
 struct RenderRun {
   Camera camera;

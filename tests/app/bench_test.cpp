@@ -1,0 +1,108 @@
+// `rastray bench`: the statistics, frames on a prepared scene (each frame
+// reports its own work, however many came before), the JSON schema and the
+// command's last line and bad input.
+#include <gtest/gtest.h>
+
+#include <regex>
+
+#include "app/bench.h"
+#include "app/stability_measure.h"
+#include "tests/app/run_command.h"
+
+namespace rastray {
+namespace {
+
+const std::string kCornell = std::string(RASTRAY_SCENES) + "/cornell-box.gltf";
+
+TEST(BenchSpread, MedianOfOddAndEvenCounts) {
+  const Spread odd = spreadOf({5.0, 1.0, 3.0});
+  EXPECT_EQ(odd.median, 3.0);
+  EXPECT_EQ(odd.min, 1.0);
+  EXPECT_EQ(odd.max, 5.0);
+  EXPECT_EQ(odd.count, 3);
+  EXPECT_EQ(spreadOf({4.0, 1.0, 2.0, 3.0}).median, 2.5);
+  EXPECT_EQ(spreadOf({}).count, 0);
+}
+
+BenchResult bench(const std::vector<std::string>& args, int frames, int warmup) {
+  BenchRequest request;
+  request.scenePath = kCornell;
+  request.settings = stability::renderSettingsFrom(args);
+  request.frames = frames;
+  request.warmup = warmup;
+  return runBench(request);
+}
+
+// Every frame does the same work, so the counters of the last frame do not
+// depend on how many frames came before it (the ray caster's counts restart
+// per frame, the BVH is kept).
+TEST(Bench, EachFrameReportsItsOwnRays) {
+  const BenchResult one = bench({"--renderer", "raytrace", "--size", "40", "30", "--spp", "4"}, 1, 0);
+  const BenchResult four = bench({"--renderer", "raytrace", "--size", "40", "30", "--spp", "4"}, 3, 1);
+  EXPECT_EQ(one.counters.get("rays.primary"), 40u * 30u * 4u);
+  EXPECT_EQ(four.counters.get("rays.primary"), 40u * 30u * 4u);
+  EXPECT_EQ(four.counters.get("rays.shadow"), one.counters.get("rays.shadow"));
+  EXPECT_EQ(four.frameSeconds.size(), 3u);
+  EXPECT_GE(four.bvhBuildSeconds, 0.0);
+  EXPECT_GT(raysPerSecond(four, "rays.primary"), 0.0);
+}
+
+TEST(Bench, HybridFramesCountTheirOwnShadowRays) {
+  const std::vector<std::string> args{"--renderer", "hybrid", "--size", "40", "30", "--shadows", "rays"};
+  const BenchResult one = bench(args, 1, 0);
+  const BenchResult three = bench(args, 2, 1);
+  EXPECT_GT(one.counters.get("rays.shadow"), 0u);
+  EXPECT_EQ(three.counters.get("rays.shadow"), one.counters.get("rays.shadow"));
+}
+
+TEST(Bench, RasterReportsStagesAndNoBvh) {
+  const BenchResult r = bench({"--size", "64", "48"}, 2, 0);
+  EXPECT_EQ(r.width, 64);
+  EXPECT_EQ(r.height, 48);
+  EXPECT_LT(r.bvhBuildSeconds, 0.0);
+  EXPECT_EQ(r.triangles, 742u);
+  bool tiles = false;
+  for (const StageTime& s : r.stages) tiles = tiles || (s.name == "raster.tiles" && s.seconds.count == 2);
+  EXPECT_TRUE(tiles);
+  EXPECT_LE(r.frame.min, r.frame.median);
+  EXPECT_LE(r.frame.median, r.frame.max);
+
+  const nlohmann::json j = benchJson(r);
+  EXPECT_EQ(j.at("schema"), "rastray.bench");
+  EXPECT_EQ(j.at("schemaVersion"), 1);
+  EXPECT_EQ(j.at("frameSeconds").size(), 2u);
+  EXPECT_TRUE(j.at("bvhBuildSeconds").is_null());
+  EXPECT_EQ(j.at("counters").at("raster.triangles_in"), 742);
+  EXPECT_TRUE(j.at("stages").contains("raster.tiles"));
+}
+
+TEST(BenchCommand, LastLineIsTheMedianFrame) {
+  const test::CommandResult r =
+      test::runRastray({"bench", kCornell, "--size", "64", "48", "--frames", "3", "--renderer", "hybrid"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("median frame: [0-9]+\\.[0-9]{3} ms\n$"))) << r.out;
+  EXPECT_NE(r.out.find("BVH build"), std::string::npos);
+}
+
+TEST(BenchCommand, GeneratedTerrainHasTheTrianglesAsked) {
+  const std::string dir = testing::TempDir() + "/bench-terrain";
+  const test::CommandResult r = test::runRastray(
+      {"bench", "terrain:2000", "--size", "80", "60", "--frames", "1", "--warmup", "0", "--work-dir", dir});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("2000 triangles"), std::string::npos) << r.out;
+}
+
+TEST(BenchCommand, BadInputExitsTwoWithOneLine) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"bench", "terrain:0", "--size", "8", "8"},
+        std::vector<std::string>{"bench", "terrain:abc"},
+        std::vector<std::string>{"bench", kCornell, "--frames", "0"},
+        std::vector<std::string>{"bench", "/nonexistent/scene.gltf"}}) {
+    const test::CommandResult r = test::runRastray(args);
+    EXPECT_EQ(r.status, 2) << args[1];
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace rastray
