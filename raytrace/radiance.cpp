@@ -30,11 +30,15 @@ glm::vec3 traceRadiance(const CasterState& state, const RayTreeContext& context,
   if (depth > shading.maxDepth || !(throughput >= shading.minThroughput)) return glm::vec3(0.0f);
   context.count(kind);
   const glm::dvec3 dir = glm::normalize(direction);
-  HitGather g;
+  // This ray's surface list stays in use while their own rays are traced
+  // (the next level of the scratch).
+  const RayScratch::Use use(*context.scratch);
+  HitGather& g = use.level().gather;
+  std::vector<SurfaceCrossing>& crossings = use.level().crossings;
   g.mode = GatherMode::Radiance;
   g.primary = false;
   g.ray = secondaryRay(secondaryRayOrigin(state, from, dir), dir, std::numeric_limits<double>::infinity());
-  std::vector<SurfaceCrossing> crossings;
+  g.hits.clear();
   collectCrossings(state, g, intersectClosest(state, g, /*coherent=*/false), &crossings);
   return glm::vec3(shadeRay(state, context, kind, depth, throughput, g, crossings, DeepTarget{}).color);
 }
@@ -43,15 +47,18 @@ glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& con
                              const SurfacePoint& point, const glm::dvec3& toLight, double distance) {
   context.count(RayKind::Shadow);
   const glm::dvec3 dir = glm::normalize(toLight);
-  HitGather g;
+  const RayScratch::Use use(*context.scratch);
+  HitGather& g = use.level().gather;
   g.mode = GatherMode::Shadow;
   g.primary = false;
   g.ray = secondaryRay(secondaryRayOrigin(state, point, dir), dir, distance);
+  g.hits.clear();
   const bool blocked = traceOcclusion(state, g);
   glm::vec3 result(blocked ? 0.0f : 1.0f);
+  // Each surface's transmittance was evaluated by the filter that let the
+  // ray through it (GatheredHit::transmittance): not again here.
   if (!blocked)
-    for (const GatheredHit& h : g.hits)
-      result *= context.shader->shadowTransmittance(surfacePointOf(state.scene, g.ray, h));
+    for (const GatheredHit& h : g.hits) result *= h.transmittance;
   if (context.recorder) {
     const GatheredHit* front = g.hits.empty() ? nullptr : &g.hits.front();
     const size_t record = context.recorder->begin(

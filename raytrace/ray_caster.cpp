@@ -49,7 +49,7 @@ class TracedRayTree : public SecondaryRayTracer, public LightVisibility {
 
   // The Shader holds these callbacks as const objects; the counts and the
   // tree they record into are this object's own, used on one thread.
-  RayTreeContext context() const { return {&shader_, &counts_, &recorder_}; }
+  RayTreeContext context() const { return {&shader_, &counts_, &recorder_, &scratch_}; }
   RayTreeRecorder& recorder() const { return recorder_; }
 
   glm::vec3 radiance(const SurfacePoint& from, const glm::dvec3& direction, RayKind kind, int depth,
@@ -66,6 +66,7 @@ class TracedRayTree : public SecondaryRayTracer, public LightVisibility {
   Shader shader_;
   mutable RayCounts counts_{};
   mutable RayTreeRecorder recorder_;
+  mutable RayScratch scratch_;
 };
 
 std::string contributionText(const glm::vec4& c) {
@@ -156,13 +157,14 @@ void RayCaster::bind(const Camera& camera, const RayOptions& options) {
   state.options = options;
   state.shader =
       std::make_unique<Shader>(state.scene, state.analysis, state.camera, options.shading, this, this);
-  state.counts.clear();
+  resetCounters();  // each thread's scratch is kept (warm) across binds
   state.bound = true;
 }
 
 RenderOutput RayCaster::render() {
   const CasterState& state = *impl_;
   RASTRAY_CHECK(state.bound, "RayCaster::render before bind");
+  resetCounters();  // the output counts this frame's rays only
   RenderOutput out = renderPrimaryVisibility(state);
   state.embree->throwIfError();
   out.counters = counters();
@@ -192,12 +194,16 @@ glm::vec3 RayCaster::transmittance(const SurfacePoint& point, int /*lightIndex*/
   return traceTransmittance(*impl_, untracedContext(*impl_), point, toLight, distance);
 }
 
+void RayCaster::resetCounters() {
+  for (ThreadRays& local : impl_->threads) local.counts = RayCounts{};
+}
+
 void RayCaster::throwIfError() const { impl_->embree->throwIfError(); }
 
 CounterSet RayCaster::counters() const {
   RayCounts total{};
-  for (const RayCounts& local : impl_->counts)
-    for (int k = 0; k < kRayKindCount; ++k) total[size_t(k)] += local[size_t(k)];
+  for (const ThreadRays& local : impl_->threads)
+    for (int k = 0; k < kRayKindCount; ++k) total[size_t(k)] += local.counts[size_t(k)];
   CounterSet set;
   for (int k = 0; k < kRayKindCount; ++k) set.set(kCounterNames[k], total[size_t(k)]);
   return set;

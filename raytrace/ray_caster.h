@@ -77,6 +77,18 @@
 //   nearest the pixel centre (centreSampleIndex).
 // - Counters: rays.primary, rays.shadow, rays.reflection, rays.refraction,
 //   rays.transparency, always all five, per thread and summed.
+// - Frames: the constructor builds the BVH once; bind() and render() may
+//   follow any number of times (another camera, other options), each
+//   render() giving exactly what a new caster would. Scratch buffers are
+//   per thread and kept across frames: no heap allocation per ray or per
+//   sample once warm (deep output: one buffer per tile, one flat image).
+// - Timings: render() reports "raytrace.primary" (primary ray setup and
+//   traversal, filter callbacks included) and "raytrace.shade" (surface
+//   lists, refinement, shading with all secondary and shadow rays), which
+//   add up to the wall time of the tile loop: each tile traces all its
+//   primary rays, then shades them, and the loop's wall time is split in
+//   proportion to the thread-seconds summed per phase (three clock reads
+//   per tile); with keepSamples also "raytrace.deep_output" (assembly).
 // - Tracing: traceDebugPixel() re-traces one pixel with single rays and
 //   returns its ray tree (RayRecord, each ray before the rays its surfaces
 //   spawned); render() with RayOptions::trace records that tree into the
@@ -170,9 +182,11 @@ class RayCaster : public SecondaryRayTracer, public LightVisibility {
   RayCaster& operator=(const RayCaster&) = delete;
 
   // Binds a camera and options: required before render() and before the
-  // interfaces below are used (hybrid rendering).
+  // interfaces below are used (hybrid rendering). May be called again
+  // between frames; the BVH is kept.
   void bind(const Camera& camera, const RayOptions& options);
 
+  // One frame of the bound camera; repeatable (identical output each time).
   RenderOutput render();
 
   // SecondaryRayTracer / LightVisibility (thread-safe; count rays by kind).
@@ -181,9 +195,12 @@ class RayCaster : public SecondaryRayTracer, public LightVisibility {
   glm::vec3 transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
                           double distance) const override;
 
-  // Rays traced since bind(), by kind (SPEC §8: zero for what the scene
-  // does not need).
+  // Rays traced since the last bind(), render() or resetCounters(), by
+  // kind (SPEC §8: zero for what the scene does not need). render()'s
+  // output counts its own frame's rays; a hybrid frame loop calls
+  // resetCounters() before each frame.
   CounterSet counters() const;
+  void resetCounters();
 
   // Throws the first Embree error since the last check (render() and
   // traceDebugPixel() check on their own; hybrid rendering calls this after

@@ -51,10 +51,93 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // Rays traced, by RayKind.
 using RayCounts = std::array<uint64_t, kRayKindCount>;
 
+// --- what a ray carries ------------------------------------------------------
+
+// A surface a ray passed through (or stopped at), as Embree reported it.
+struct GatheredHit {
+  float traversalT = kInf;  // Embree's float t: where its traversal found the hit
+  uint32_t instance = kNoId, triangle = kNoId;
+  float u = 0.0f, v = 0.0f;  // Embree's barycentrics
+  // Shadow rays: Shader::shadowTransmittance of the surface, evaluated once
+  // by the filter that let the ray through it (1 for radiance rays).
+  glm::vec3 transmittance{1.0f};
+};
+
+enum class GatherMode { Radiance, Shadow };
+
+// Per-ray state the filter callbacks fill: every hit they reject so that
+// traversal continues (BLEND layers; for shadow rays every surface that
+// lets light through). Opaque hits are accepted and shrink tfar.
+struct HitGather {
+  GatherMode mode = GatherMode::Radiance;
+  Ray ray;               // the traced ray, in double (for refinement)
+  bool primary = false;  // MASK coverage uses the pixel footprint then
+  glm::dvec2 imagePosition{0.0};
+  std::vector<GatheredHit> hits;
+};
+
+// One surface of a ray's front-to-back list: a BLEND layer the ray
+// continues behind, or the surface it stops at. It carries two depths:
+// - traversalDepth, Embree's float t × depthPerT: what the ray caster's
+//   own traversal found, reported as Z (the compare tool measures it);
+// - refined.depth, the plane depth: planeT × depthPerT, with planeT the
+//   ray's intersection with the triangle's plane in double (refineHit),
+//   where the surface is shaded exactly as the rasterizer shades it.
+struct SurfaceCrossing {
+  SampleHit refined;  // refineHit(): clamped barycentrics, depth = the plane depth
+  float traversalDepth = 0.0f;
+  // The plane t in double (Embree's t when the plane cannot be
+  // intersected): the list's order, then instance and triangle.
+  double planeT = 0.0;
+  bool blend = false;  // a BLEND layer: the ray continues behind it
+};
+
+// Scratch one thread reuses for the secondary and shadow rays it traces, so
+// that once warm they allocate nothing: a stack of levels, one per ray in
+// flight on the thread (a ray's surface list stays in use while the rays
+// its surfaces spawn are traced). Held through RayScratch::Use.
+class RayScratch {
+ public:
+  struct Level {
+    HitGather gather;
+    std::vector<SurfaceCrossing> crossings;
+  };
+
+  // The next free level, for one ray, released when the Use ends.
+  class Use {
+   public:
+    explicit Use(RayScratch& scratch) : scratch_(scratch), level_(scratch.push()) {}
+    ~Use() { --scratch_.top_; }
+    Use(const Use&) = delete;
+    Use& operator=(const Use&) = delete;
+    Level& level() const { return level_; }
+
+   private:
+    RayScratch& scratch_;
+    Level& level_;
+  };
+
+ private:
+  Level& push() {
+    // unique_ptr: growing the stack must not move the levels in use.
+    if (top_ == levels_.size()) levels_.push_back(std::make_unique<Level>());
+    return *levels_[top_++];
+  }
+  std::vector<std::unique_ptr<Level>> levels_;
+  size_t top_ = 0;
+};
+
+// What each thread tracing rays keeps: its counts since bind() and its
+// scratch (kept across renders).
+struct ThreadRays {
+  RayCounts counts{};
+  RayScratch scratch;
+};
+
 // --- state -------------------------------------------------------------------
 
 // The caster's state: built by the constructor, completed by bind(), then
-// only read by the parts (the per-thread counts excepted).
+// only read by the parts (the per-thread counts and scratch excepted).
 struct CasterState {
   CasterState(const Scene& s, const SceneAnalysis& a, CullMode c) : scene(s), analysis(a), cull(c) {}
 
@@ -69,7 +152,7 @@ struct CasterState {
   Camera camera;
   RayOptions options;
   std::unique_ptr<Shader> shader;  // calls back into the RayCaster: untraced rays
-  mutable tbb::enumerable_thread_specific<RayCounts> counts{RayCounts{}};
+  mutable tbb::enumerable_thread_specific<ThreadRays> threads;
 };
 
 // --- the context one ray tree is traced in ------------------------------------
@@ -135,13 +218,15 @@ struct RayTreeContext {
   const Shader* shader = nullptr;
   RayCounts* counts = nullptr;
   RayTreeRecorder* recorder = nullptr;
+  RayScratch* scratch = nullptr;  // the calling thread's (or the traced pixel's own)
 
   void count(RayKind kind, uint64_t n = 1) const { (*counts)[size_t(kind)] += n; }
 };
 
 // The context of untraced rays on the calling thread.
 inline RayTreeContext untracedContext(const CasterState& state) {
-  return {state.shader.get(), &state.counts.local(), nullptr};
+  ThreadRays& local = state.threads.local();
+  return {state.shader.get(), &local.counts, nullptr, &local.scratch};
 }
 
 // --- transparency continuation (transparency.cpp) ------------------------------
@@ -165,26 +250,6 @@ class FlushDenormalsScope {
   unsigned saved_;
 };
 
-// A surface a ray passed through (or stopped at), as Embree reported it.
-struct GatheredHit {
-  float traversalT = kInf;  // Embree's float t: where its traversal found the hit
-  uint32_t instance = kNoId, triangle = kNoId;
-  float u = 0.0f, v = 0.0f;  // Embree's barycentrics
-};
-
-enum class GatherMode { Radiance, Shadow };
-
-// Per-ray state the filter callbacks fill: every hit they reject so that
-// traversal continues (BLEND layers; for shadow rays every surface that
-// lets light through). Opaque hits are accepted and shrink tfar.
-struct HitGather {
-  GatherMode mode = GatherMode::Radiance;
-  Ray ray;               // the traced ray, in double (for refinement)
-  bool primary = false;  // MASK coverage uses the pixel footprint then
-  glm::dvec2 imagePosition{0.0};
-  std::vector<GatheredHit> hits;
-};
-
 // Embree's context extended with our per-call data: the documented way to
 // hand filter callbacks per-query state. `embree` must stay the first
 // member (the callback receives a pointer to it).
@@ -195,22 +260,6 @@ struct GatherContext {
 static_assert(std::is_standard_layout<GatherContext>::value, "GatherContext must be standard layout");
 static_assert(offsetof(GatherContext, embree) == 0,
               "RTCIntersectContext must be GatherContext's first member");
-
-// One surface of a ray's front-to-back list: a BLEND layer the ray
-// continues behind, or the surface it stops at. It carries two depths:
-// - traversalDepth, Embree's float t × depthPerT: what the ray caster's
-//   own traversal found, reported as Z (the compare tool measures it);
-// - refined.depth, the plane depth: planeT × depthPerT, with planeT the
-//   ray's intersection with the triangle's plane in double (refineHit),
-//   where the surface is shaded exactly as the rasterizer shades it.
-struct SurfaceCrossing {
-  SampleHit refined;  // refineHit(): clamped barycentrics, depth = the plane depth
-  float traversalDepth = 0.0f;
-  // The plane t in double (Embree's t when the plane cannot be
-  // intersected): the list's order, then instance and triangle.
-  double planeT = 0.0;
-  bool blend = false;  // a BLEND layer: the ray continues behind it
-};
 
 // The Embree filter callback of every geometry that needs one, for every
 // ray kind (geometryUserPtr: the CasterState): accepts or rejects each hit

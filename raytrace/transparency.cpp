@@ -14,7 +14,7 @@ namespace rastray {
 namespace {
 
 // Defined below, each after the function that uses it.
-bool acceptHit(const CasterState& state, HitGather& g, const GatheredHit& hit);
+bool acceptHit(const CasterState& state, HitGather& g, GatheredHit& hit);
 bool maskCovers(const CasterState& state, const HitGather& g, const SurfacePoint& p);
 bool isFrontFacing(const Scene& scene, const GatheredHit& hit, const glm::dvec3& direction);
 RTCRayHit makeRayHit(const glm::vec3& origin, const glm::vec3& direction, float tnear, float tfar,
@@ -46,8 +46,9 @@ void gatherFilter(const RTCFilterFunctionNArguments* args) {
 
 namespace {
 
-// Accept (true) or reject (false, traversal continues) one hit.
-bool acceptHit(const CasterState& state, HitGather& g, const GatheredHit& hit) {
+// Accept (true) or reject (false, traversal continues) one hit; a shadow
+// ray's hit it lets through keeps its transmittance.
+bool acceptHit(const CasterState& state, HitGather& g, GatheredHit& hit) {
   const Scene& scene = state.scene;
   const Material& m = scene.materialOf(hit.instance);
   if (state.cull != CullMode::None && isCulled(state.cull, m, isFrontFacing(scene, hit, g.ray.direction)))
@@ -62,8 +63,8 @@ bool acceptHit(const CasterState& state, HitGather& g, const GatheredHit& hit) {
     return false;
   }
   // Shadow rays: gather everything that lets light through.
-  const glm::vec3 st = state.shader->shadowTransmittance(surfacePointOf(scene, g.ray, hit));
-  if (st == glm::vec3(0.0f)) return true;  // blocks: ends the occlusion query
+  hit.transmittance = state.shader->shadowTransmittance(surfacePointOf(scene, g.ray, hit));
+  if (hit.transmittance == glm::vec3(0.0f)) return true;  // blocks: ends the occlusion query
   g.hits.push_back(hit);
   return false;
 }
