@@ -128,6 +128,27 @@ nlohmann::json benchJson(const BenchResult& r) {
   return j;
 }
 
+std::string benchCsvHeader() {
+  return "scene,renderer,width,height,spp,threads,triangles,load_ms,bvh_build_ms,frame_median_ms,frame_min_"
+         "ms,"
+         "frame_max_ms,frames,peak_rss_mib,primary_mrays_per_s";
+}
+
+std::string benchCsvRow(const BenchResult& r) {
+  char row[512];
+  std::string scene = r.scenePath;
+  for (char& c : scene)
+    if (c == ',' || c == '"') c = '_';  // a path with a comma stays one field
+  char bvh[32] = "";                    // empty without a ray caster
+  if (r.bvhBuildSeconds >= 0.0) std::snprintf(bvh, sizeof bvh, "%.3f", r.bvhBuildSeconds * 1e3);
+  std::snprintf(row, sizeof row, "%s,%s,%d,%d,%d,%d,%llu,%.3f,%s,%.3f,%.3f,%.3f,%d,%.1f,%.3f", scene.c_str(),
+                toString(r.renderer), r.width, r.height, r.spp, r.threads,
+                static_cast<unsigned long long>(r.triangles), r.loadSeconds * 1e3, bvh, r.frame.median * 1e3,
+                r.frame.min * 1e3, r.frame.max * 1e3, r.frame.count,
+                double(r.peakRssBytes) / (1024.0 * 1024.0), raysPerSecond(r, "rays.primary") / 1e6);
+  return row;
+}
+
 std::string benchText(const BenchResult& r) {
   std::string out;
   char line[256];

@@ -64,6 +64,11 @@ double raysPerSecond(const BenchResult& result, const std::string& counter);
 // stages, counters, rays per second and peak memory.
 nlohmann::json benchJson(const BenchResult& result);
 
+// One CSV row (no line break) and its header, for scripts that gather
+// many runs into one table (bench/scaling.sh).
+std::string benchCsvHeader();
+std::string benchCsvRow(const BenchResult& result);
+
 // The human-readable table `rastray bench` prints, ending in the line
 // "median frame: <ms> ms" that scripts read.
 std::string benchText(const BenchResult& result);

@@ -26,6 +26,7 @@ struct BenchCommandOptions {
   int warmup = 1;
   std::string workDir = "bench-work";
   std::string jsonPath;
+  std::string csvPath;
   RenderSettings settings;
 };
 
@@ -78,6 +79,13 @@ int runBenchCommand(BenchCommandOptions& opt) {
   BenchResult result = runBench(request);
   if (terminal) std::fputs("\r\033[K", stderr);
   std::fputs(benchText(result).c_str(), stdout);
+  if (!opt.csvPath.empty()) {
+    const bool fresh = !std::filesystem::exists(opt.csvPath) || std::filesystem::file_size(opt.csvPath) == 0;
+    std::ofstream f(opt.csvPath, std::ios::app);
+    if (fresh) f << benchCsvHeader() << "\n";
+    f << benchCsvRow(result) << "\n";
+    if (!f) throw InputError(opt.csvPath, "file", "cannot append");
+  }
   if (!opt.jsonPath.empty()) {
     const nlohmann::json j = benchJson(result);
     const std::string partial = opt.jsonPath + ".partial";
@@ -104,6 +112,7 @@ CommandRunner addBenchCommand(CLI::App& app) {
   cmd->add_option("--work-dir", opt->workDir,
                   "Where generated terrains and the peers' exported OBJ files go");
   cmd->add_option("--json", opt->jsonPath, "Also write the results as JSON (schema rastray.bench v1)");
+  cmd->add_option("--csv", opt->csvPath, "Append one row to this CSV file (a header first when it is new)");
   addRenderSettings(*cmd, opt->settings);
   return [opt, cmd]() -> int { return cmd->parsed() ? runBenchCommand(*opt) : -1; };
 }

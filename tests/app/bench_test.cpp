@@ -76,6 +76,16 @@ TEST(Bench, RasterReportsStagesAndNoBvh) {
   EXPECT_TRUE(j.at("stages").contains("raster.tiles"));
 }
 
+TEST(Bench, CsvRowMatchesItsHeader) {
+  BenchResult r = bench({"--renderer", "raytrace", "--size", "16", "12"}, 1, 0);
+  const auto fields = [](const std::string& line) { return std::count(line.begin(), line.end(), ',') + 1; };
+  EXPECT_EQ(fields(benchCsvRow(r)), fields(benchCsvHeader()));
+  EXPECT_NE(benchCsvRow(r).find(",raytrace,16,12,1,"), std::string::npos) << benchCsvRow(r);
+  r.scenePath = "a,b.gltf";  // a comma in a path must not add a field
+  r.bvhBuildSeconds = -1.0;  // nor an absent BVH remove one
+  EXPECT_EQ(fields(benchCsvRow(r)), fields(benchCsvHeader()));
+}
+
 TEST(BenchCommand, LastLineIsTheMedianFrame) {
   const test::CommandResult r =
       test::runRastray({"bench", kCornell, "--size", "64", "48", "--frames", "3", "--renderer", "hybrid"});
