@@ -57,26 +57,32 @@ glm::dvec2 Camera::ndcScale() const {
   return {t * aspect, t};
 }
 
-Ray Camera::primaryRay(glm::dvec2 image) const {
-  const glm::dvec2 ndc = ndcFromImage(image);
-  const glm::dvec2 scale = ndcScale();
+Ray Camera::primaryRay(glm::dvec2 image) const { return PrimaryRays(*this)(image); }
+
+PrimaryRays::PrimaryRays(const Camera& camera)
+    : camera_(camera), scale_(camera.ndcScale()), eye_(camera.eye()), forward_(camera.forward()) {}
+
+Ray PrimaryRays::operator()(glm::dvec2 image) const {
+  const Camera& camera = camera_;
+  const glm::dvec2 ndc = camera.ndcFromImage(image);
+  const glm::dvec2 scale = scale_;
   Ray ray;
-  if (projection == Projection::Orthographic) {
-    ray.origin = glm::dvec3(worldFromView * glm::dvec4(ndc.x * scale.x, ndc.y * scale.y, 0.0, 1.0));
-    ray.direction = forward();
+  if (camera.projection == Projection::Orthographic) {
+    ray.origin = glm::dvec3(camera.worldFromView * glm::dvec4(ndc.x * scale.x, ndc.y * scale.y, 0.0, 1.0));
+    ray.direction = forward_;
     ray.depthPerT = 1.0;
-    ray.tNear = znear;
-    ray.tFar = zfar;
+    ray.tNear = camera.znear;
+    ray.tFar = camera.zfar;
     return ray;
   }
   // The point on the view plane at depth 1; its length converts depth to t.
   const glm::dvec3 viewDir(ndc.x * scale.x, ndc.y * scale.y, -1.0);
   const double length = glm::length(viewDir);
-  ray.origin = eye();
-  ray.direction = glm::normalize(glm::dvec3(worldFromView * glm::dvec4(viewDir, 0.0)));
+  ray.origin = eye_;
+  ray.direction = glm::normalize(glm::dvec3(camera.worldFromView * glm::dvec4(viewDir, 0.0)));
   ray.depthPerT = 1.0 / length;
-  ray.tNear = znear * length;
-  ray.tFar = zfar * length;  // inf stays inf
+  ray.tNear = camera.znear * length;
+  ray.tFar = camera.zfar * length;  // inf stays inf
   return ray;
 }
 

@@ -73,12 +73,28 @@ struct Camera {
   // everywhere (orthographic): x_ndc = x_view / (scale.x · depth) etc.
   glm::dvec2 ndcScale() const;
 
-  // The primary ray through an image position.
+  // The primary ray through an image position (PrimaryRays, below, for
+  // many of them).
   Ray primaryRay(glm::dvec2 image) const;
 
   // One line, e.g. "perspective yfov 45.0° aspect 1.333 znear 0.01 zfar inf
   // eye (0, 1, 5) forward (0, 0, -1) [node 2 'Camera' (camera 0)]".
   std::string describe() const;
+};
+
+// Camera::primaryRay with what depends on the camera alone (the NDC scale,
+// a tangent; the eye; the forward direction) computed once: bit-identical
+// rays (Camera::primaryRay is this), for loops over many image positions.
+// Holds a reference: the camera must outlive it.
+class PrimaryRays {
+ public:
+  explicit PrimaryRays(const Camera& camera);
+  Ray operator()(glm::dvec2 image) const;
+
+ private:
+  const Camera& camera_;
+  glm::dvec2 scale_;
+  glm::dvec3 eye_, forward_;
 };
 
 // Rebases the scene (rebaseScene) on the point `mode` names: the eye of the

@@ -61,13 +61,19 @@ bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t tria
   // are ordered by (instance, triangle) in both renderers.
   std::array<glm::dvec3, 3> corner = {glm::dvec3(scene.positions[v.x]), glm::dvec3(scene.positions[v.y]),
                                       glm::dvec3(scene.positions[v.z])};
-  std::array<int, 3> order = {0, 1, 2};
-  std::sort(order.begin(), order.end(), [&](int i, int j) {
+  // Three compare-exchanges (a sorting network) instead of std::sort: the
+  // same order for distinct corners; equal corners make det 0 below, so
+  // their order never shows.
+  auto less = [&](int i, int j) {
     const glm::dvec3 &p = corner[size_t(i)], &q = corner[size_t(j)];
     if (p.x != q.x) return p.x < q.x;
     if (p.y != q.y) return p.y < q.y;
     return p.z < q.z;
-  });
+  };
+  std::array<int, 3> order = {0, 1, 2};
+  if (less(order[1], order[0])) std::swap(order[0], order[1]);
+  if (less(order[2], order[1])) std::swap(order[1], order[2]);
+  if (less(order[1], order[0])) std::swap(order[0], order[1]);
   const glm::dvec3 &a = corner[size_t(order[0])], &b = corner[size_t(order[1])],
                    &c = corner[size_t(order[2])];
   // Möller–Trumbore in double, without the inside test.
@@ -95,6 +101,10 @@ SampleHit refineHit(const Scene& scene, const Ray& ray, const SampleHit& hit) {
   double t;
   glm::dvec2 b;
   if (!intersectTrianglePlane(scene, hit.instance, hit.triangle, ray, &t, &b)) return hit;
+  return refineHitAt(ray, hit, t, b);
+}
+
+SampleHit refineHitAt(const Ray& ray, const SampleHit& hit, double t, glm::dvec2 b) {
   // A plane behind the origin (or at it) is not what the renderer saw:
   // keep its hit.
   if (!(t > 0.0) || !std::isfinite(t * ray.depthPerT)) return hit;

@@ -51,6 +51,10 @@ bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t tria
 // when the plane cannot be intersected or the intersection is not ahead
 // of the ray (t <= 0, or a depth that is not finite).
 SampleHit refineHit(const Scene& scene, const Ray& ray, const SampleHit& hit);
+// refineHit from the plane point (t, barycentrics) intersectTrianglePlane
+// already returned true for this hit and ray: the same result, without
+// intersecting the plane again.
+SampleHit refineHitAt(const Ray& ray, const SampleHit& hit, double t, glm::dvec2 barycentrics);
 
 // Texture-space footprint of one pixel at a surface point: d(uv)/dx and
 // d(uv)/dy per image pixel. Both renderers compute it the same way, from

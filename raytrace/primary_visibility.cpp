@@ -316,7 +316,7 @@ void setupPrimary(const CasterState& state, HitGather& g, glm::ivec2 pixel, cons
   g.mode = GatherMode::Radiance;
   g.primary = true;
   g.imagePosition = glm::dvec2(pixel) + position;
-  g.ray = state.camera.primaryRay(g.imagePosition);
+  g.ray = (*state.primaryRays)(g.imagePosition);
   g.hits.clear();
 }
 

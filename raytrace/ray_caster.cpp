@@ -154,6 +154,7 @@ void RayCaster::bind(const Camera& camera, const RayOptions& options) {
   if (options.shading.maxDepth < 0) throw InputError("command line", "--max-depth", "must be >= 0");
   CasterState& state = *impl_;
   state.camera = camera;
+  state.primaryRays.emplace(state.camera);
   state.options = options;
   state.shader =
       std::make_unique<Shader>(state.scene, state.analysis, state.camera, options.shading, this, this);

@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
@@ -150,6 +151,7 @@ struct CasterState {
   // Set by RayCaster::bind.
   bool bound = false;
   Camera camera;
+  std::optional<PrimaryRays> primaryRays;  // of `camera`
   RayOptions options;
   std::unique_ptr<Shader> shader;  // calls back into the RayCaster: untraced rays
   mutable tbb::enumerable_thread_specific<ThreadRays> threads;

@@ -168,6 +168,12 @@ RTCRayHit makeRayHit(const glm::vec3& origin, const glm::vec3& direction, float 
 void collectCrossings(const CasterState& state, HitGather& g, const GatheredHit& closest,
                       std::vector<SurfaceCrossing>* crossings) {
   crossings->clear();
+  if (g.hits.empty()) {
+    // Nothing gathered (every opaque scene): the list is the stopping hit
+    // alone, as the general path below would make it.
+    if (closest.instance != kNoId) crossings->push_back(toSurfaceCrossing(state.scene, g.ray, closest));
+    return;
+  }
   if (closest.instance != kNoId) {
     // Layers Embree reported before it found a closer stopping hit lie
     // behind it.
@@ -202,10 +208,14 @@ SurfaceCrossing toSurfaceCrossing(const Scene& scene, const Ray& ray, const Gath
   traversed.depth = float(double(h.traversalT) * ray.depthPerT);
   SurfaceCrossing crossing;
   crossing.planeT = h.traversalT;
+  crossing.refined = traversed;
   double t;
   glm::dvec2 b;
-  if (intersectTrianglePlane(scene, h.instance, h.triangle, ray, &t, &b)) crossing.planeT = t;
-  crossing.refined = refineHit(scene, ray, traversed);
+  // One plane intersection for both: refineHitAt is refineHit from it.
+  if (intersectTrianglePlane(scene, h.instance, h.triangle, ray, &t, &b)) {
+    crossing.planeT = t;
+    crossing.refined = refineHitAt(ray, traversed, t, b);
+  }
   crossing.traversalDepth = traversed.depth;
   crossing.blend = scene.materialOf(h.instance).alphaMode == AlphaMode::Blend;
   return crossing;

@@ -114,5 +114,40 @@ TEST(RefineHit, BarycentricsOutsideTheTriangleAreClampedIntoIt) {
   }
 }
 
+// The plane intersection is the same to the bit whatever order a
+// triangle lists its corners in (canonical corner order; two corners tie
+// in x and two in x and y, so every comparison of the order matters):
+// the same t and the same weight for each corner; and refineHitAt from it
+// is refineHit.
+TEST(RefineHit, CornerOrderDoesNotChangeThePlanePoint) {
+  const glm::vec3 corners[3] = {{0.5f, 2.0f, 3.0f}, {0.5f, 2.0f, -1.5f}, {-0.25f, 5.0f, 1.0f}};
+  const int orders[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (const glm::dvec3 origin : {glm::dvec3(7.0, 1.0, 0.3), glm::dvec3(-4.0, 3.3, 2.0)}) {
+    const Ray ray = rayThrough(origin, {0.3, 3.0, 1.1});
+    double t0 = 0.0;
+    // Each original corner's weight, from the first order that returns it
+    // (b holds the weights of stored corners 1 and 2).
+    double weight[3];
+    bool seen[3] = {false, false, false};
+    for (int k = 0; k < 6; ++k) {
+      Scene s = triangleScene();
+      for (int i = 0; i < 3; ++i) s.positions[size_t(i)] = corners[orders[k][i]];
+      double t;
+      glm::dvec2 b;
+      ASSERT_TRUE(intersectTrianglePlane(s, 0, 0, ray, &t, &b));
+      if (k == 0) t0 = t;
+      EXPECT_EQ(t, t0) << "order " << k;
+      for (int slot = 1; slot < 3; ++slot) {
+        const int corner = orders[k][slot];
+        const double w = slot == 1 ? b.x : b.y;
+        if (!seen[corner]) weight[corner] = w;
+        seen[corner] = true;
+        EXPECT_EQ(w, weight[corner]) << "order " << k << " corner " << corner;
+      }
+      expectSame(refineHitAt(ray, rendererHit(1.0f), t, b), refineHit(s, ray, rendererHit(1.0f)));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rastray
