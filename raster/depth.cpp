@@ -1,22 +1,6 @@
 #include "raster/depth.h"
 
-#include <algorithm>
-#include <cmath>
-#include <cstring>
-
 namespace rastray {
-
-namespace {
-
-uint32_t floatBits(float f) {
-  uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  return u;
-}
-
-constexpr uint32_t kOneBits = 0x3F800000u;  // 1.0f: the largest stored float
-
-}  // namespace
 
 DepthEncoding encodingOf(DepthFormat format) {
   switch (format) {
@@ -34,21 +18,6 @@ DepthEncoding encodingOf(DepthFormat format) {
 
 double windowDepth(DepthFormat format, Projection projection, double znear, double zfar, double d) {
   return storedWindowDepth(encodingOf(format), projection, znear, zfar, d);
-}
-
-uint32_t depthKey(DepthFormat format, double z) {
-  z = std::clamp(z, 0.0, 1.0);
-  switch (format) {
-    case DepthFormat::Float:
-      return floatBits(float(z));
-    case DepthFormat::FloatReversed:
-      return kOneBits - floatBits(float(z));  // larger z: smaller key
-    case DepthFormat::Unorm24:
-      return uint32_t(std::lround(z * double((1u << 24) - 1u)));
-    case DepthFormat::Unorm16:
-      return uint32_t(std::lround(z * double((1u << 16) - 1u)));
-  }
-  return kClearDepthKey;
 }
 
 double minimumResolvableDifference(DepthFormat format, double maxZ) {

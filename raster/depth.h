@@ -29,7 +29,10 @@
 // format's far plane, so the first fragment at a sample always passes.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "common/depth_formula.h"
 #include "raster/options.h"
@@ -46,7 +49,27 @@ DepthEncoding encodingOf(DepthFormat format);
 double windowDepth(DepthFormat format, Projection projection, double znear, double zfar, double d);
 
 // The key stored for window depth z (clamped to [0, 1] first, as GL clamps).
-uint32_t depthKey(DepthFormat format, double z);
+// Inline: the depth pass calls it at every covered sample.
+inline uint32_t depthKey(DepthFormat format, double z) {
+  constexpr uint32_t kOneBits = 0x3F800000u;  // 1.0f: the largest stored float
+  const auto floatBits = [](float f) {
+    uint32_t u;
+    std::memcpy(&u, &f, sizeof u);
+    return u;
+  };
+  z = std::clamp(z, 0.0, 1.0);
+  switch (format) {
+    case DepthFormat::Float:
+      return floatBits(float(z));
+    case DepthFormat::FloatReversed:
+      return kOneBits - floatBits(float(z));  // larger z: smaller key
+    case DepthFormat::Unorm24:
+      return uint32_t(std::lround(z * double((1u << 24) - 1u)));
+    case DepthFormat::Unorm16:
+      return uint32_t(std::lround(z * double((1u << 16) - 1u)));
+  }
+  return kClearDepthKey;
+}
 
 // True when the format stores larger z for nearer surfaces.
 inline bool isReversed(DepthFormat format) { return format == DepthFormat::FloatReversed; }

@@ -17,7 +17,7 @@ void TileRenderer::opaquePass(const TileRect& rect, const std::vector<uint32_t>&
   if (analysis_.alphaTest)
     alphaTest = [this](const TriangleSetup& t, int px, int py, int s) { return alphaCovered(t, px, py, s); };
   rasterDepthPass(setups_, bin, grid_, rect, options_.depthFormat, options_.depthFunc, alphaTest, trace,
-                  target, &n.opaque);
+                  target, &n.opaque, coveragePath());
 }
 
 TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,

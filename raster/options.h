@@ -36,6 +36,10 @@ struct RasterOptions {
   bool wireframe = false;
   bool halo = false;         // with wireframe: gap lines where a nearer line crosses them
   bool keepSamples = false;  // fill RenderOutput::samples (deep output, crossval)
+  // The camera passes walk coverage with the scalar reference loop instead
+  // of the block-classified one (raster/coverage.h); the results are
+  // identical, only slower. For the tests that prove it.
+  bool referenceCoverage = false;
   ShadingOptions shading;
   // Records what each stage did at one pixel into trace.sink (common/trace.h):
   // tile, setup and edge functions, coverage, depth and MASK tests, shading,

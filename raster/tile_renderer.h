@@ -106,6 +106,9 @@ class TileRenderer {
                     ThreadCounters& n) const;
   bool alphaCovered(const TriangleSetup& t, int px, int py, int s) const;
   glm::dvec2 samplePosition(const TileSampleIndex& index, uint32_t local) const;
+  CoveragePath coveragePath() const {
+    return options_.referenceCoverage ? CoveragePath::Reference : CoveragePath::Fast;
+  }
 
   // Pass 1 (opaque_pass.cpp).
   void opaquePass(const TileRect& rect, const std::vector<uint32_t>& bin, const TraceRequest& trace,

@@ -21,17 +21,22 @@ void TileRenderer::forEachFragment(const TileSampleIndex& index, const std::vect
   for (uint32_t setup : triangles) {
     const TriangleSetup& t = setups_[setup];
     const uint64_t id = t.id();
-    n.blendCoverageTests += forEachCoveredSample(t, grid_, index.rect, scratch, [&](int px, int py, int s) {
-      ++n.blendSamplesTested;
-      const size_t i = target.index(px, py, s);
-      const uint32_t key = sampleDepthKey(t, grid_, options_.depthFormat, px, py, s);
-      const uint32_t win = target.winners[i];
-      if (!passesDepthTest(options_.depthFunc, key, id, target.keys[i],
-                           win == kNoSetup ? UINT64_MAX : setups_[win].id()))
-        return;
-      const glm::dvec2 pos = glm::dvec2(px, py) + grid_.positions[size_t(s)];
-      f(BlendFragment{index(px, py, s), planeDepth(t, pos), id, setup, 0});
-    });
+    n.blendCoverageTests +=
+        forEachCoveredSample(coveragePath(), t, grid_, index.rect, scratch, [&](int px, int py, int s) {
+          ++n.blendSamplesTested;
+          const size_t i = target.index(px, py, s);
+          const uint32_t key = sampleDepthKey(t, grid_, options_.depthFormat, px, py, s);
+          const uint32_t stored = target.keys[i];
+          if (key > stored) return;
+          if (key == stored) {  // only a tie needs the stored winner's id (passesDepthTest)
+            const uint32_t win = target.winners[i];
+            if (!passesDepthTest(options_.depthFunc, key, id, stored,
+                                 win == kNoSetup ? UINT64_MAX : setups_[win].id()))
+              return;
+          }
+          const glm::dvec2 pos = glm::dvec2(px, py) + grid_.positions[size_t(s)];
+          f(BlendFragment{index(px, py, s), planeDepth(t, pos), id, setup, 0});
+        });
   }
 }
 

@@ -1,0 +1,261 @@
+// Pass 1's depth test and write (rasterDepthPass, coverage.h).
+//
+// The fast path walks each triangle block by block (block_coverage.h) and
+// tests the covered samples of a block from its masks. In front of that, a
+// hierarchical depth test per block of the rect: an upper bound of the
+// keys stored in the block against a lower bound of the triangle's keys
+// there; a block where the triangle is behind everything stored is skipped
+// (every sample would fail: key > stored, ties impossible). Within one
+// triangle every sample is tested once, so the order of the samples does
+// not change the result; the triangles keep their bin order. The reference
+// path (CoveragePath::Reference) and the traced triangles run the scalar
+// per-sample loop in (py, px, s) order, without the hierarchical test.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "raster/coverage.h"
+
+namespace rastray {
+
+namespace {
+
+std::string hexKey(uint32_t key) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08x", key);
+  return buf;
+}
+
+// Whether the traced pixel lies in t's pixel bounds within the tile.
+bool tracedIn(const TraceRequest& trace, const TriangleSetup& t, const TileRect& rect) {
+  return trace.sink && trace.pixel.x >= std::max(rect.x0, t.pixelMin.x) &&
+         trace.pixel.x <= std::min(rect.x1 - 1, t.pixelMax.x) &&
+         trace.pixel.y >= std::max(rect.y0, t.pixelMin.y) &&
+         trace.pixel.y <= std::min(rect.y1 - 1, t.pixelMax.y);
+}
+
+// The depth test at a sample: the fragment's key against the stored key and
+// the setup that wrote it (instance and triangle -1 when nothing did).
+void traceDepthTest(TraceSink& sink, const std::vector<TriangleSetup>& setups, const TriangleSetup& t, int s,
+                    uint32_t key, uint32_t stored, uint32_t winner, bool pass) {
+  TraceEvent e{TraceStage::Depth, s, t.instance, t.triangle, 1, pass ? "pass" : "fail", {}};
+  e.add("key", hexKey(key)).add("stored", hexKey(stored));
+  e.add("stored_instance", winner == kNoSetup ? "-1" : std::to_string(setups[winner].instance));
+  e.add("stored_triangle", winner == kNoSetup ? "-1" : std::to_string(setups[winner].triangle));
+  sink.record(std::move(e));
+}
+
+// Per block of the rect (kCoverageBlock² pixels aligned to its corner): an
+// upper bound of every key stored there, recomputed from the target when a
+// write has made it stale (keys only decrease, so a stale bound is still
+// an upper bound, only a looser one).
+class BlockDepthBounds {
+ public:
+  BlockDepthBounds(const DepthTarget& target, const TileRect& rect)
+      : target_(target),
+        rect_(rect),
+        columns_((rect.x1 - rect.x0 + kCoverageBlock - 1) / kCoverageBlock),
+        bound_(size_t(columns_) * size_t((rect.y1 - rect.y0 + kCoverageBlock - 1) / kCoverageBlock),
+               kClearDepthKey),
+        stale_(bound_.size(), 1) {}
+
+  size_t block(int x, int y) const {
+    return size_t((y - rect_.y0) / kCoverageBlock) * size_t(columns_) +
+           size_t((x - rect_.x0) / kCoverageBlock);
+  }
+  uint32_t bound(size_t b) {
+    if (stale_[b]) refresh(b);
+    return bound_[b];
+  }
+  void markStale(size_t b) { stale_[b] = 1; }
+  void markStale(const PixelBounds& r) {
+    constexpr int B = kCoverageBlock;
+    for (int y = rect_.y0 + (r.y0 - rect_.y0) / B * B; y <= r.y1; y += B)
+      for (int x = rect_.x0 + (r.x0 - rect_.x0) / B * B; x <= r.x1; x += B) stale_[block(x, y)] = 1;
+  }
+
+ private:
+  void refresh(size_t b) {
+    const int x0 = rect_.x0 + int(b % size_t(columns_)) * kCoverageBlock;
+    const int y0 = rect_.y0 + int(b / size_t(columns_)) * kCoverageBlock;
+    const int x1 = std::min(x0 + kCoverageBlock, rect_.x1), y1 = std::min(y0 + kCoverageBlock, rect_.y1);
+    uint32_t m = 0;
+    for (int y = y0; y < y1; ++y) {
+      const uint32_t* row = &target_.keys[target_.index(x0, y, 0)];
+      for (size_t i = 0, n = size_t(x1 - x0) * size_t(target_.spp); i < n; ++i) m = std::max(m, row[i]);
+    }
+    bound_[b] = m;
+    stale_[b] = 0;
+  }
+
+  const DepthTarget& target_;
+  TileRect rect_;
+  int columns_;
+  std::vector<uint32_t> bound_;
+  std::vector<uint8_t> stale_;
+};
+
+// A lower bound of the key t gets at any sample in the box [xa, xb] ×
+// [ya, yb] (pixels) of the depth plane, or, with `vertices`, at any sample
+// inside the triangle (its exact plane values there lie between those at
+// the snapped vertices, which are then used as the box's corners). Widened
+// by a margin for rounding: Plane::at evaluates v0 + dx·(x − x0) + dy·(y −
+// y0) in double; with u = 2^-53 each of its five operations errs by at
+// most u relative, and the position x (px + ox, or a vertex ÷ U) by u·|x|,
+// so a computed sample value lies within ≈ 5u·(|v0| + |dx·(x − x0)| +
+// |dy·(y − y0)| + |dx·x| + |dy·y|) of the exact plane at the exact
+// position, and so does the bound computed here: the margin 2^-45 times
+// that sum (its largest over the corners; the sample's own lies between)
+// covers both with a wide slack. depthKey is monotone in z
+// (non-decreasing, non-increasing for reversed formats), so the key of the
+// widened extreme bounds every sample's key. 0 (no bound) when the plane
+// is not finite there.
+uint32_t minKeyOf(DepthFormat format, const Plane& p, const double (&x)[3], const double (&y)[3], int n) {
+  double lo = INFINITY, hi = -INFINITY, size = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double u = p.dx * (x[i] - p.x0), v = p.dy * (y[i] - p.y0);
+    const double z = p.v0 + u + v;
+    lo = std::min(lo, z);
+    hi = std::max(hi, z);
+    size = std::max(
+        size, std::abs(p.v0) + std::abs(u) + std::abs(v) + std::abs(p.dx * x[i]) + std::abs(p.dy * y[i]));
+  }
+  const double margin = std::ldexp(size, -45);
+  if (!std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(margin)) return 0;
+  return isReversed(format) ? depthKey(format, hi + margin) : depthKey(format, lo - margin);
+}
+
+// Over the box of block b's sample positions: its four corners, as the
+// plane is affine (the extremes of an affine function over a box).
+uint32_t minKeyOverBlock(const TriangleSetup& t, DepthFormat format, const PixelBlock& b,
+                         const glm::dvec2& lowPos, const glm::dvec2& highPos) {
+  const double xa = double(b.x) + lowPos.x, xb = double(b.x + b.w - 1) + highPos.x;
+  const double ya = double(b.y) + lowPos.y, yb = double(b.y + b.h - 1) + highPos.y;
+  const Plane& p = t.depth;
+  // The corner minimising (maximising) each term: the affine extremes.
+  const double x[3] = {p.dx >= 0 ? xa : xb, p.dx >= 0 ? xb : xa, 0.0};
+  const double y[3] = {p.dy >= 0 ? ya : yb, p.dy >= 0 ? yb : ya, 0.0};
+  return minKeyOf(format, p, x, y, 2);
+}
+
+// Over the triangle: its three snapped vertices.
+uint32_t minKeyOverTriangle(const TriangleSetup& t, DepthFormat format, int64_t U) {
+  double x[3], y[3];
+  for (int i = 0; i < 3; ++i) {
+    x[i] = double(t.vertex[i].x) / double(U);  // rounded only when k > 1: in the margin
+    y[i] = double(t.vertex[i].y) / double(U);
+  }
+  return minKeyOf(format, t.depth, x, y, 3);
+}
+
+}  // namespace
+
+void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
+                     const SampleGrid& grid, const TileRect& rect, DepthFormat format, DepthFunc func,
+                     const std::function<bool(const TriangleSetup&, int, int, int)>& alphaTest,
+                     const TraceRequest& trace, DepthTarget* target, DepthPassCounters* counters,
+                     CoveragePath path) {
+  CoverageScratch scratch;
+  const bool keysOnly = target->winners.empty();
+  uint32_t* keys = target->keys.data();
+  uint32_t* winners = target->winners.data();
+  const int spp = grid.spp;
+  const int64_t U = grid.unitsPerPixel;
+  BlockDepthBounds bounds(*target, rect);
+  glm::dvec2 lowPos(1.0), highPos(0.0);
+  for (const glm::dvec2& q : grid.positions) {
+    lowPos = glm::min(lowPos, q);
+    highPos = glm::max(highPos, q);
+  }
+
+  // The depth test and write of t at one sample; true when written.
+  const auto test = [&](const TriangleSetup& t, uint32_t index, uint64_t id, int px, int py, int s,
+                        bool traceHere) {
+    const size_t i = target->index(px, py, s);
+    const uint32_t key = sampleDepthKey(t, grid, format, px, py, s);
+    const uint32_t stored = keys[i];
+    // The stored winner's id (another setup, likely out of cache) only
+    // decides ties; keys only (shadow maps): ties change no key, so the
+    // id rule is moot and a tie fails.
+    bool pass = key < stored;
+    if (key == stored && !keysOnly) {
+      const uint32_t winner = winners[i];
+      pass = passesDepthTest(func, key, id, stored, winner == kNoSetup ? UINT64_MAX : setups[winner].id());
+    }
+    const bool traced = traceHere && px == trace.pixel.x && py == trace.pixel.y;
+    if (traced)
+      traceDepthTest(*trace.sink, setups, t, s, key, stored, keysOnly ? kNoSetup : winners[i], pass);
+    if (!pass) return false;
+    if (alphaTest && !alphaTest(t, px, py, s)) {
+      ++counters->alphaRejected;
+      if (traced)
+        trace.sink->record(TraceEvent{TraceStage::Alpha, s, t.instance, t.triangle, 1, "discarded", {}}.add(
+            "coverage", "below the MASK cutoff"));
+      return false;
+    }
+    ++counters->samplesPassed;
+    keys[i] = key;
+    if (!keysOnly) winners[i] = index;
+    return true;
+  };
+
+  for (uint32_t index : bin) {
+    const TriangleSetup& t = setups[index];
+    const uint64_t id = t.id();
+    const bool traceHere = tracedIn(trace, t, rect);
+    if (traceHere || path == CoveragePath::Reference) {
+      if (traceHere) traceCoverage(*trace.sink, t, grid, trace.pixel.x, trace.pixel.y);
+      uint64_t tested = 0;
+      counters->coverageTests +=
+          forEachCoveredSample(path, t, grid, rect, scratch, [&](int px, int py, int s) {
+            ++tested;
+            test(t, index, id, px, py, s, traceHere);
+          });
+      counters->samplesTested += tested;
+      const PixelBounds r = boundsIn(t, rect);
+      if (!r.empty()) bounds.markStale(r);
+      continue;
+    }
+
+    const PixelBounds r = boundsIn(t, rect);
+    if (r.empty()) continue;
+    counters->coverageTests += r.samples(spp);
+    prepareOffsets(t, grid, scratch);
+    const uint32_t triangleKey = minKeyOverTriangle(t, format, U);
+    uint64_t* masks = scratch.masks.data();
+    constexpr int B = kCoverageBlock;
+    for (int by = rect.y0 + (r.y0 - rect.y0) / B * B; by <= r.y1; by += B)
+      for (int bx = rect.x0 + (r.x0 - rect.x0) / B * B; bx <= r.x1; bx += B) {
+        const int cx0 = std::max(bx, r.x0), cy0 = std::max(by, r.y0);
+        const PixelBlock b{cx0, cy0, std::min(bx + B - 1, r.x1) - cx0 + 1,
+                           std::min(by + B - 1, r.y1) - cy0 + 1};
+        int64_t lo[3];
+        const BlockClass c = classifyBlock(t, scratch, U, b, lo);
+        if (c == BlockClass::Reject) continue;
+        const size_t hb = bounds.block(bx, by);
+        const uint32_t stored = bounds.bound(hb);
+        if (stored != kClearDepthKey &&
+            std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos)) > stored)
+          continue;
+        if (c == BlockClass::Accept) {
+          const uint64_t full = fullBlockMask(b);
+          for (int s = 0; s < spp; ++s) masks[s] = full;
+        } else {
+          blockMasks(t, scratch, U, spp, b, lo, masks);
+        }
+        bool wrote = false;
+        for (int s = 0; s < spp; ++s) {
+          uint64_t m = masks[s];
+          counters->samplesTested += uint64_t(__builtin_popcountll(m));
+          while (m) {
+            const int bit = __builtin_ctzll(m);
+            m &= m - 1;
+            wrote |= test(t, index, id, b.x + (bit & 7), b.y + (bit >> 3), s, false);
+          }
+        }
+        if (wrote) bounds.markStale(hb);
+      }
+  }
+}
+
+}  // namespace rastray

@@ -1,0 +1,264 @@
+// The fast coverage walk and depth pass (block classification, int32/SSE2
+// masks, hierarchical depth) against the scalar reference, on seeded
+// random scenes built to hit the corner cases: tiny, sliver, huge (the
+// int64 fallback), off-screen triangles, vertices on sample positions,
+// shared edges (fill-rule ties) and coplanar duplicates (depth-key ties).
+#include <gtest/gtest.h>
+
+#include <random>
+#include <tuple>
+
+#include "raster/bin.h"
+#include "raster/coverage.h"
+#include "raster/setup.h"
+#include "raster_test_util.h"
+
+namespace rastray {
+namespace {
+
+constexpr int kSize = 150;  // not a multiple of the tile or block size
+
+// Image position (x, y) → world for orthoCamera(kSize, kSize / 2): one
+// world unit per pixel, so a 1/16-pixel grid is exact in float.
+glm::vec3 world(double x, double y, double z) {
+  return glm::vec3(float(x - kSize / 2.0), float(kSize / 2.0 - y), float(z));
+}
+
+// A random scene of `count` triangles of mixed kinds.
+Scene randomScene(uint32_t seed, int count) {
+  std::mt19937 rng(seed);
+  const auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  // On the 1/16-pixel grid: the 4 and 16 spp patterns' sample positions lie on it.
+  const auto snap = [](double v) { return std::round(v * 16.0) / 16.0; };
+  const auto depth = [&]() { return -uniform(1.0, 9.0); };
+  Scene scene;
+  for (int i = 0; i < count; ++i) {
+    const int kind = int(rng() % 7);
+    std::vector<glm::vec3> p;
+    std::vector<glm::uvec3> t = {{0, 1, 2}};
+    const double cx = snap(uniform(-20.0, kSize + 20.0)), cy = snap(uniform(-20.0, kSize + 20.0));
+    switch (kind) {
+      case 0:  // tiny
+        for (int k = 0; k < 3; ++k)
+          p.push_back(world(cx + snap(uniform(-2, 2)), cy + snap(uniform(-2, 2)), depth()));
+        break;
+      case 1: {  // sliver: the third vertex 1/16 px off the long edge
+        const double ex = snap(uniform(-kSize, kSize)), ey = snap(uniform(-kSize, kSize));
+        p = {world(cx, cy, depth()), world(cx + ex, cy + ey, depth()),
+             world(cx + ex / 2 + 1.0 / 16, cy + ey / 2, depth())};
+        break;
+      }
+      case 2:  // huge: far beyond the image (large edge coefficients)
+        for (int k = 0; k < 3; ++k)
+          p.push_back(world(snap(uniform(-6000, 6000)), snap(uniform(-6000, 6000)), depth()));
+        break;
+      case 3:  // off-screen
+        for (int k = 0; k < 3; ++k)
+          p.push_back(world(kSize + 50 + uniform(0, 30), uniform(0, kSize), depth()));
+        break;
+      case 4: {  // a fan of shared edges around a centre on a pixel-centre position
+        const double r = uniform(3, 40);
+        const double z = depth();
+        p.push_back(world(std::floor(cx) + 0.5, std::floor(cy) + 0.5, z));
+        const int n = 3 + int(rng() % 6);
+        for (int k = 0; k <= n; ++k) {
+          const double a = 2.0 * kPi * k / n;
+          p.push_back(world(std::floor(cx + r * std::cos(a)) + 0.5, std::floor(cy + r * std::sin(a)) + 0.5,
+                            z + uniform(-0.5, 0.5)));
+        }
+        t.clear();
+        for (int k = 1; k <= n; ++k) t.push_back({0u, uint32_t(k), uint32_t(k + 1)});
+        break;
+      }
+      case 5: {  // a quad split along its diagonal, both halves in one plane, and a coplanar copy
+        const double w = snap(uniform(1, 60)), h = snap(uniform(1, 60));
+        const double z0 = depth(), z1 = depth();
+        p = {world(cx, cy, z0), world(cx + w, cy, z0), world(cx + w, cy + h, z1), world(cx, cy + h, z1)};
+        t = {{0, 1, 2}, {0, 2, 3}};
+        test::addMesh(scene, p, t);  // the copy: exact key ties, decided by id
+        break;
+      }
+      default:  // medium
+        for (int k = 0; k < 3; ++k)
+          p.push_back(world(cx + snap(uniform(-40, 40)), cy + snap(uniform(-40, 40)), depth()));
+        break;
+    }
+    test::addMesh(scene, p, t);
+  }
+  return scene;
+}
+
+std::vector<TriangleSetup> setupScene(const Scene& scene, const Camera& camera, const SampleGrid& grid,
+                                      DepthFormat format) {
+  const ClipSpace space = makeClipSpace(camera, grid.guardPixels);
+  const DepthSettings ds{format, camera.projection, camera.znear, camera.zfar, 0, 0};
+  SetupCounters n;
+  return prepareTriangles(scene, space, grid, ds, CullMode::None, {}, &n);
+}
+
+using Sample = std::tuple<int, int, int>;
+
+TEST(CoverageEquivalence, BlockWalkVisitsTheReferenceSamplesInOrder) {
+  const Camera camera = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
+  for (uint32_t seed = 1; seed <= 6; ++seed) {
+    const Scene scene = randomScene(seed, 120);
+    for (int spp : {1, 4, 16, 25}) {
+      const SampleGrid grid = makeSampleGrid(spp, kSize, kSize);
+      const auto setups = setupScene(scene, camera, grid, DepthFormat::FloatReversed);
+      ASSERT_GT(setups.size(), 60u);
+      std::mt19937 rng(seed * 100 + uint32_t(spp));
+      std::vector<TileRect> rects = {TileRect{0, 0, kSize, kSize}, TileRect{64, 64, 128, 128},
+                                     TileRect{128, 128, kSize, kSize}};
+      for (int k = 0; k < 3; ++k) {  // unaligned rects
+        const int x0 = int(rng() % kSize), y0 = int(rng() % kSize);
+        rects.push_back(TileRect{x0, y0, x0 + 1 + int(rng() % uint32_t(kSize - x0)),
+                                 y0 + 1 + int(rng() % uint32_t(kSize - y0))});
+      }
+      CoverageScratch scratch;
+      for (const TriangleSetup& t : setups)
+        for (const TileRect& r : rects) {
+          std::vector<Sample> fast, slow;
+          const uint64_t nf = forEachCoveredSample(t, grid, r, scratch,
+                                                   [&](int x, int y, int s) { fast.emplace_back(x, y, s); });
+          const uint64_t ns = forEachCoveredSampleReference(
+              t, grid, r, scratch, [&](int x, int y, int s) { slow.emplace_back(x, y, s); });
+          ASSERT_EQ(nf, ns);
+          ASSERT_EQ(fast, slow) << "seed " << seed << " spp " << spp << " triangle " << t.instance << "/"
+                                << t.triangle << " rect " << r.x0 << "," << r.y0 << "-" << r.x1 << ","
+                                << r.y1;
+        }
+    }
+  }
+}
+
+struct PassResult {
+  DepthTarget target;
+  DepthPassCounters counters;
+};
+
+// Two depth passes over every tile (the first half of the setups, then the
+// rest, so the second starts from a filled target), with a MASK-like
+// alpha test that drops a hashed subset of the samples of odd instances.
+PassResult depthPass(const std::vector<TriangleSetup>& setups, const SampleGrid& grid, DepthFormat format,
+                     DepthFunc func, bool keysOnly, CoveragePath path) {
+  PassResult r{DepthTarget(kSize, kSize, grid.spp, keysOnly), {}};
+  const std::function<bool(const TriangleSetup&, int, int, int)> alpha = [](const TriangleSetup& t, int x,
+                                                                            int y, int s) {
+    return t.instance % 2 == 0 ||
+           ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ uint32_t(s) ^ t.triangle) % 5 != 0;
+  };
+  const TileGrid tiles(kSize, kSize);
+  const size_t half = setups.size() / 2;
+  for (const auto& [from, to] : {std::pair<size_t, size_t>{0, half}, {half, setups.size()}}) {
+    std::vector<uint32_t> bin;
+    for (size_t i = from; i < to; ++i) bin.push_back(uint32_t(i));
+    for (int tile = 0; tile < tiles.count(); ++tile)
+      rasterDepthPass(setups, bin, grid, tiles.rect(tile), format, func, alpha, TraceRequest{}, &r.target,
+                      &r.counters, path);
+  }
+  return r;
+}
+
+TEST(CoverageEquivalence, FastDepthPassWritesTheReferenceKeysAndWinners) {
+  const Camera ortho = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
+  const Camera persp =
+      test::perspectiveCamera(kSize, kSize, 1.2, glm::dvec3(0, 0, 70), glm::dvec3(0, 0, 0), 0.5);
+  const DepthFormat formats[] = {DepthFormat::FloatReversed, DepthFormat::Float, DepthFormat::Unorm24,
+                                 DepthFormat::Unorm16};
+  for (uint32_t seed = 11; seed <= 12; ++seed) {
+    const Scene scene = randomScene(seed, 150);
+    for (int spp : {1, 4, 16})
+      for (DepthFormat format : formats)
+        for (const Camera* camera : {&ortho, &persp}) {
+          const SampleGrid grid = makeSampleGrid(spp, kSize, kSize);
+          const auto setups = setupScene(scene, *camera, grid, format);
+          ASSERT_GT(setups.size(), 50u);
+          for (DepthFunc func : {DepthFunc::Less, DepthFunc::LEqual})
+            for (int mode = 0; mode < (func == DepthFunc::Less ? 2 : 1); ++mode) {  // keys only: no function
+              const bool keysOnly = mode == 1;
+              const PassResult fast = depthPass(setups, grid, format, func, keysOnly, CoveragePath::Fast);
+              const PassResult slow =
+                  depthPass(setups, grid, format, func, keysOnly, CoveragePath::Reference);
+              const std::string what = "seed " + std::to_string(seed) + " spp " + std::to_string(spp) + " " +
+                                       toString(format) + " " + toString(func) +
+                                       (keysOnly ? " keys only" : "") +
+                                       (camera == &ortho ? " ortho" : " perspective");
+              ASSERT_EQ(fast.target.keys, slow.target.keys) << what;
+              ASSERT_EQ(fast.target.winners, slow.target.winners) << what;
+              EXPECT_EQ(fast.counters.coverageTests, slow.counters.coverageTests) << what;
+              EXPECT_EQ(fast.counters.samplesPassed, slow.counters.samplesPassed) << what;
+              EXPECT_EQ(fast.counters.alphaRejected, slow.counters.alphaRejected) << what;
+              // The hierarchical depth test skips samples that would fail.
+              EXPECT_LE(fast.counters.samplesTested, slow.counters.samplesTested) << what;
+            }
+        }
+  }
+}
+
+TEST(CoverageEquivalence, HierarchicalDepthSkipsOccludedBlocks) {
+  // A full-screen quad in front, then many triangles behind it: after the
+  // quad, no sample behind it reaches the per-sample test.
+  Scene scene;
+  test::addMesh(scene,
+                {world(-1, -1, -1), world(kSize + 1, -1, -1), world(kSize + 1, kSize + 1, -1),
+                 world(-1, kSize + 1, -1)},
+                {{0, 1, 2}, {0, 2, 3}});
+  const Scene behind = randomScene(3, 100);
+  for (const Instance& inst : behind.instances) {
+    std::vector<glm::vec3> p(behind.positions.begin() + inst.firstVertex,
+                             behind.positions.begin() + inst.firstVertex + inst.vertexCount);
+    for (glm::vec3& v : p) v.z = std::min(v.z, -2.0f);
+    std::vector<glm::uvec3> t;
+    for (uint32_t i = 0; i < inst.triangleCount; ++i)
+      t.push_back(behind.triangles[inst.firstTriangle + i] - glm::uvec3(inst.firstVertex));
+    test::addMesh(scene, p, t);
+  }
+  const Camera camera = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
+  const SampleGrid grid = makeSampleGrid(4, kSize, kSize);
+  const auto setups = setupScene(scene, camera, grid, DepthFormat::FloatReversed);
+  const PassResult fast =
+      depthPass(setups, grid, DepthFormat::FloatReversed, DepthFunc::Less, false, CoveragePath::Fast);
+  const PassResult slow =
+      depthPass(setups, grid, DepthFormat::FloatReversed, DepthFunc::Less, false, CoveragePath::Reference);
+  ASSERT_EQ(fast.target.winners, slow.target.winners);
+  // The quad's own samples, and nothing behind it.
+  EXPECT_EQ(fast.counters.samplesTested, uint64_t(kSize) * kSize * 4);
+  EXPECT_GT(slow.counters.samplesTested, 2 * fast.counters.samplesTested);
+}
+
+TEST(CoverageEquivalence, RendersMatchTheReferenceWalkWithMaskAndBlend) {
+  Scene scene = randomScene(21, 120);
+  // Every third instance MASK with a constant alpha below the cutoff on
+  // half of them, every fifth BLEND: the alpha test and the transparency
+  // pass's walk.
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    Material& m = scene.materials[i];
+    m.baseColorFactor = glm::vec4(float(i % 7) / 7.0f, float(i % 3) / 3.0f, 0.5f, 1.0f);
+    if (i % 3 == 1) {
+      m.alphaMode = AlphaMode::Mask;
+      m.alphaCutoff = 0.5f;
+      m.baseColorFactor.a = i % 2 ? 0.25f : 0.75f;
+    } else if (i % 5 == 2) {
+      m.alphaMode = AlphaMode::Blend;
+      m.baseColorFactor.a = 0.5f;
+    }
+  }
+  const Camera camera = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
+  for (int spp : {1, 4}) {
+    RasterOptions options;
+    options.spp = spp;
+    options.shadows = ShadowMode::None;
+    const RenderOutput fast = test::render(scene, camera, options);
+    options.referenceCoverage = true;
+    const RenderOutput slow = test::render(scene, camera, options);
+    EXPECT_EQ(fast.image.color, slow.image.color) << spp;
+    EXPECT_EQ(fast.image.depth, slow.image.depth) << spp;
+    EXPECT_EQ(fast.image.instance, slow.image.instance) << spp;
+    EXPECT_EQ(fast.image.triangle, slow.image.triangle) << spp;
+    EXPECT_GT(fast.counters.get("raster.fragments_transparent"), 0u);
+    EXPECT_GT(fast.counters.get("raster.alpha_rejected"), 0u);
+  }
+}
+
+}  // namespace
+}  // namespace rastray
