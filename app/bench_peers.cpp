@@ -114,6 +114,7 @@ bool parsePeerOutput(const std::string& out, PeerRun& run) {
   std::string line;
   bool haveMedian = false;
   run.frameMs.clear();
+  run.cpuMs.clear();
   while (std::getline(in, line)) {
     const auto rest = [&](const char* prefix) { return line.substr(std::char_traits<char>::length(prefix)); };
     unsigned index = 0;
@@ -131,6 +132,9 @@ bool parsePeerOutput(const std::string& out, PeerRun& run) {
                std::string(unit) == "ms") {
       run.medianMs = ms;
       haveMedian = true;
+    } else if (std::sscanf(line.c_str(), "median cpu: %lf %7s", &ms, unit) == 2 &&
+               std::string(unit) == "ms") {
+      run.medianCpuMs = ms;
     } else if (std::sscanf(line.c_str(), "frame %u: %lf %7s", &index, &ms, unit) == 3 &&
                std::string(unit) == "ms") {
       if (index != run.frameMs.size()) {
@@ -138,10 +142,16 @@ bool parsePeerOutput(const std::string& out, PeerRun& run) {
         return false;
       }
       run.frameMs.push_back(ms);
+      double cpu = 0;
+      if (std::sscanf(line.c_str(), "frame %*u: %*f ms (cpu %lf ms)", &cpu) == 1) run.cpuMs.push_back(cpu);
     }
   }
   if (run.frameMs.empty() || !haveMedian) {
     run.error = "no frame times in the peer's output";
+    return false;
+  }
+  if (!run.cpuMs.empty() && run.cpuMs.size() != run.frameMs.size()) {
+    run.error = "a CPU time on some frame lines only";
     return false;
   }
   return true;

@@ -42,6 +42,10 @@ struct PeerRun {
   std::vector<std::string> notes;  // the peer's "note:" lines and the viewer's own command
   std::vector<double> frameMs;     // the timed frames, in order
   double medianMs = 0;             // the peer's own "median frame" line
+  // CPU time of all the peer's threads per frame (OSMesa only; empty for
+  // the viewer), and its median: the load-independent part of the frame.
+  std::vector<double> cpuMs;
+  double medianCpuMs = 0;
 };
 
 // Runs rastray_osmesa_peer, found beside this executable (build/) or in
@@ -57,7 +61,8 @@ PeerRun runEmbreeViewer(const PeerRequest& request);
 std::vector<std::string> peerCameraArgs(const Camera& camera);
 
 // Reads a peer's standard output into `run`: "renderer: …", "note: …",
-// "command: …", "frame I: T ms" and the last "median frame: M ms". False
+// "command: …", "obj: …", "frame I: T ms" (optionally "(cpu C ms)"),
+// "median cpu: C ms" and the last "median frame: M ms". False
 // (with run.error set) when the frame lines or the median are missing.
 bool parsePeerOutput(const std::string& out, PeerRun& run);
 

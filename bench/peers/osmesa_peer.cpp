@@ -10,8 +10,10 @@
 //   common/depth_formula.h's reversed window depth;
 // - two colour attachments: the eye-light colour (base colour factor ×
 //   the diffuse weight (1 − w)(1 − t) × |n·d| + emissive, common/shading.h
-//   without textures or COLOR_0) in sRGB8_ALPHA8, and the IDs (instance
-//   from a per-draw uniform, triangle = gl_PrimitiveID) in RG32UI;
+//   without textures or COLOR_0) in RGBA8 (linear, the plain 8-bit target
+//   an application draws into; an sRGB8_ALPHA8 target measured ~10 %
+//   slower), and the IDs (instance from a per-draw uniform, triangle =
+//   gl_PrimitiveID) in RG32UI;
 // - MSAA with --spp samples per pixel, resolved with glBlitFramebuffer
 //   (colour averaged, IDs and depth from one sample);
 // - the resolved colour, IDs and depth read back with glReadPixels, as
@@ -21,7 +23,8 @@
 // call per instance; every material is drawn opaque (no MASK or BLEND).
 //
 // Output (stdout): renderer, threads, scene and upload lines, "frame I: T
-// ms" per timed frame and last "median frame: M ms". Exit status 0; 2 for
+// ms (cpu C ms)" per timed frame (C: the CPU time of all the process's
+// threads), "median cpu: C ms" and last "median frame: M ms". Exit status 0; 2 for
 // bad input (one line on stderr); 1 when OpenGL fails.
 #include <GL/osmesa.h>
 
@@ -29,6 +32,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -239,7 +243,7 @@ GLuint makeFramebuffer(const GlApi& gl, int samples, int w, int h) {
   gl.GenFramebuffers(1, &fbo);
   gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
   gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
-                             makeRenderbuffer(gl, samples, GL_SRGB8_ALPHA8, w, h));
+                             makeRenderbuffer(gl, samples, GL_RGBA8, w, h));
   gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER,
                              makeRenderbuffer(gl, samples, GL_RG32UI, w, h));
   gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
@@ -263,7 +267,7 @@ struct InstanceDraw {
 };
 
 struct Readback {
-  std::vector<uint8_t> color;  // sRGB-encoded RGBA8, bottom row first
+  std::vector<uint8_t> color;  // linear RGBA8, bottom row first
   std::vector<uint32_t> ids;   // (instance, triangle) pairs
   std::vector<float> depth;    // stored reversed depth s
 };
@@ -369,8 +373,7 @@ int run(const Options& o) {
   gl.ClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_GREATER);
-  glEnable(GL_FRAMEBUFFER_SRGB);  // the colour attachment stores sRGB, blends and resolves in linear
-  glDisable(GL_CULL_FACE);        // rastray's default: --cull none
+  glDisable(GL_CULL_FACE);  // rastray's default: --cull none
   if (o.spp > 1) glEnable(GL_MULTISAMPLE);
   glViewport(0, 0, w, h);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -432,14 +435,23 @@ int run(const Options& o) {
   frame();
   checkGl("warm-up frame");
   std::printf("warm-up: %.3f ms\n", std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-  std::vector<double> frameMs;
+  // CPU time of every thread of the process (llvmpipe's included): on a
+  // shared machine the wall time also holds other programs' turns.
+  const auto cpuNowMs = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+  };
+  std::vector<double> frameMs, cpuMs;
   for (int i = 0; i < o.frames; ++i) {
     t0 = Clock::now();
+    const double cpu0 = cpuNowMs();
     frame();
     frameMs.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    cpuMs.push_back(cpuNowMs() - cpu0);
   }
   checkGl("frames");
-  printFrameTimes(frameMs);
+  printFrameTimes(frameMs, cpuMs);
 
   if (!o.out.empty()) {
     if (o.noReadback) readBack();  // the frames left the pixels on the GL side
@@ -449,11 +461,9 @@ int run(const Options& o) {
       for (int x = 0; x < w; ++x) {
         const size_t s = src + x, d = image.index(x, y);
         const uint8_t* c = &rb.color[4 * s];
-        const float a = c[3] / 255.0f;
-        // sRGB bytes → linear; the resolve averaged colour over black, so
-        // linear colour with this alpha is premultiplied already.
-        image.color[d] = glm::vec4(srgbToLinear(c[0] / 255.0f), srgbToLinear(c[1] / 255.0f),
-                                   srgbToLinear(c[2] / 255.0f), a);
+        // The resolve averaged colour over transparent black: linear
+        // colour with this alpha is premultiplied already.
+        image.color[d] = glm::vec4(c[0], c[1], c[2], c[3]) / 255.0f;
         image.instance[d] = rb.ids[2 * s];
         image.triangle[d] = rb.ids[2 * s + 1];
         image.depth[d] = viewDepthOf(camera, rb.depth[s], image.instance[d] != kNoId);

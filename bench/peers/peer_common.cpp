@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <limits>
 
 #include "common/error.h"
 #include "common/math_constants.h"
@@ -54,7 +55,7 @@ void addCameraOptions(CLI::App& app, PeerCameraArgs& args) {
   app.add_option("--xmag", args.xmag, "orthographic half width");
   app.add_option("--ymag", args.ymag, "orthographic half height");
   app.add_option("--znear", args.znear, "near plane distance");
-  app.add_option("--zfar", args.zfar, "far plane distance, or inf (the default)");
+  app.add_option("--zfar", args.zfar, "far plane distance, or inf (default: inf, or the file camera's)");
 }
 
 Camera resolveCamera(Scene& scene, const PeerCameraArgs& args) {
@@ -66,7 +67,7 @@ Camera resolveCamera(Scene& scene, const PeerCameraArgs& args) {
     CameraOverrides overrides;
     if (args.yfovDegrees != 0) overrides.yfovDegrees = args.yfovDegrees;
     if (args.znear != 0) overrides.znear = args.znear;
-    if (args.zfar != "inf") overrides.zfar = parseZfar(args.zfar);
+    if (!args.zfar.empty()) overrides.zfar = parseZfar(args.zfar);
     if (!args.origin.empty())
       rebaseScene(scene, vec3Of(args.origin, "--origin"));
     else
@@ -100,7 +101,7 @@ Camera resolveCamera(Scene& scene, const PeerCameraArgs& args) {
   camera.aspect = args.aspect != 0 ? args.aspect : double(width) / double(height);
   if (!(camera.aspect > 0.0 && std::isfinite(camera.aspect))) badOption("--aspect", "must be finite and > 0");
   camera.znear = args.znear;
-  camera.zfar = parseZfar(args.zfar);
+  camera.zfar = args.zfar.empty() ? std::numeric_limits<double>::infinity() : parseZfar(args.zfar);
   if (camera.projection == Projection::Perspective) {
     if (!(args.yfovDegrees > 0.0 && args.yfovDegrees < 180.0))
       badOption("--yfov", "a perspective camera needs --yfov in (0, 180) degrees");
@@ -126,8 +127,15 @@ double medianOf(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-void printFrameTimes(const std::vector<double>& frameMs) {
-  for (size_t i = 0; i < frameMs.size(); ++i) std::printf("frame %zu: %.3f ms\n", i, frameMs[i]);
+void printFrameTimes(const std::vector<double>& frameMs, const std::vector<double>& cpuMs) {
+  const bool cpu = cpuMs.size() == frameMs.size() && !cpuMs.empty();
+  for (size_t i = 0; i < frameMs.size(); ++i) {
+    if (cpu)
+      std::printf("frame %zu: %.3f ms (cpu %.3f ms)\n", i, frameMs[i], cpuMs[i]);
+    else
+      std::printf("frame %zu: %.3f ms\n", i, frameMs[i]);
+  }
+  if (cpu) std::printf("median cpu: %.3f ms\n", medianOf(cpuMs));
   std::printf("median frame: %.3f ms\n", medianOf(frameMs));
   std::fflush(stdout);
 }

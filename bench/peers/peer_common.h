@@ -29,9 +29,8 @@ struct PeerCameraArgs {
   double yfovDegrees = 0;  // perspective; 0: not given
   double aspect = 0;       // 0: width / height
   double xmag = 0, ymag = 0;
-  double znear = 0;  // 0 with an explicit camera: refused
-  std::string zfar = "inf";
-  bool zfarGiven = false;
+  double znear = 0;  // 0: not given (refused with an explicit perspective camera)
+  std::string zfar;  // a number or "inf"; empty: not given (inf with an explicit camera)
 };
 
 // Registers SCENE's camera options on `app` (everything above).
@@ -47,9 +46,11 @@ Camera resolveCamera(Scene& scene, const PeerCameraArgs& args);
 // even count); 0 for none.
 double medianOf(std::vector<double> values);
 
-// Prints "frame I: T ms" for every frame, then "median frame: M ms" (3
-// decimals), the last line the bench runner reads.
-void printFrameTimes(const std::vector<double>& frameMs);
+// Prints "frame I: T ms" for every frame (with cpuMs, parallel to frameMs:
+// "frame I: T ms (cpu C ms)"), then "median frame: M ms" (3 decimals), the
+// last line the bench runner reads. With cpuMs a "median cpu: C ms" line
+// comes before it.
+void printFrameTimes(const std::vector<double>& frameMs, const std::vector<double>& cpuMs = {});
 
 // Parses the command line into `app`, runs `body` and maps exceptions to
 // SPEC §7 exit statuses: bad usage (CLI11) and InputError print one line on

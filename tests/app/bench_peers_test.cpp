@@ -144,6 +144,8 @@ Agreement compareWithRaster(const std::string& name, const std::string& scene,
   EXPECT_TRUE(run.ran) << run.skipped << run.error;
   EXPECT_EQ(run.frameMs.size(), 2u);
   EXPECT_GT(run.medianMs, 0.0);
+  EXPECT_EQ(run.cpuMs.size(), 2u);
+  EXPECT_GT(run.medianCpuMs, 0.0);
   EXPECT_NE(run.renderer.find("Mesa"), std::string::npos) << run.renderer;
   if (!run.ran) return {};
   return agreement(readExr(request.imageOut),
@@ -315,6 +317,19 @@ TEST(BenchPeers, ParsesFrameLinesAndRefusesIncompleteOutput) {
   EXPECT_EQ(run.medianMs, 1.75);
   ASSERT_EQ(run.notes.size(), 1u);
   EXPECT_EQ(run.notes[0], "wider picture");
+
+  EXPECT_TRUE(run.cpuMs.empty());
+
+  PeerRun withCpu;
+  ASSERT_TRUE(
+      parsePeerOutput("frame 0: 2.000 ms (cpu 3.500 ms)\nframe 1: 4.000 ms (cpu 7.250 ms)\n"
+                      "median cpu: 5.375 ms\nmedian frame: 3.000 ms\n",
+                      withCpu))
+      << withCpu.error;
+  EXPECT_EQ(withCpu.frameMs, (std::vector<double>{2.0, 4.0}));
+  EXPECT_EQ(withCpu.cpuMs, (std::vector<double>{3.5, 7.25}));
+  EXPECT_EQ(withCpu.medianCpuMs, 5.375);
+  EXPECT_EQ(withCpu.medianMs, 3.0);
 
   PeerRun noMedian;
   EXPECT_FALSE(parsePeerOutput("frame 0: 1.500 ms\n", noMedian));
