@@ -100,7 +100,7 @@ double raysPerSecond(const BenchResult& result, const std::string& counter) {
 nlohmann::json benchJson(const BenchResult& r) {
   nlohmann::json j;
   j["schema"] = "rastray.bench";
-  j["schemaVersion"] = 1;
+  j["version"] = 1;
   j["scene"] = r.scenePath;
   j["renderer"] = toString(r.renderer);
   j["width"] = r.width;

@@ -69,7 +69,7 @@ TEST(Bench, RasterReportsStagesAndNoBvh) {
 
   const nlohmann::json j = benchJson(r);
   EXPECT_EQ(j.at("schema"), "rastray.bench");
-  EXPECT_EQ(j.at("schemaVersion"), 1);
+  EXPECT_EQ(j.at("version"), 1);
   EXPECT_EQ(j.at("frameSeconds").size(), 2u);
   EXPECT_TRUE(j.at("bvhBuildSeconds").is_null());
   EXPECT_EQ(j.at("counters").at("raster.triangles_in"), 742);
