@@ -63,9 +63,17 @@ class BlockDepthBounds {
     return size_t((y - rect_.y0) / kCoverageBlock) * size_t(columns_) +
            size_t((x - rect_.x0) / kCoverageBlock);
   }
-  uint32_t bound(size_t b) {
-    if (stale_[b]) refresh(b);
-    return bound_[b];
+  // Whether every key stored in block b is nearer than the lowest key a
+  // triangle can have there (lowestKey(), computed only when needed): a
+  // stale bound that already decides it is not refreshed.
+  template <typename F>
+  bool culls(size_t b, F lowestKey) {
+    if (bound_[b] == kClearDepthKey && !stale_[b]) return false;
+    const uint32_t lowest = lowestKey();
+    if (lowest > bound_[b]) return true;
+    if (!stale_[b]) return false;
+    refresh(b);
+    return lowest > bound_[b];
   }
   void markStale(size_t b) { stale_[b] = 1; }
   void markStale(const PixelBounds& r) {
@@ -79,12 +87,17 @@ class BlockDepthBounds {
     const int x0 = rect_.x0 + int(b % size_t(columns_)) * kCoverageBlock;
     const int y0 = rect_.y0 + int(b / size_t(columns_)) * kCoverageBlock;
     const int x1 = std::min(x0 + kCoverageBlock, rect_.x1), y1 = std::min(y0 + kCoverageBlock, rect_.y1);
-    uint32_t m = 0;
+    // Four running maxima: independent chains, not one long dependency.
+    uint32_t m[4] = {0, 0, 0, 0};
+    const size_t n = size_t(x1 - x0) * size_t(target_.spp);
     for (int y = y0; y < y1; ++y) {
       const uint32_t* row = &target_.keys[target_.index(x0, y, 0)];
-      for (size_t i = 0, n = size_t(x1 - x0) * size_t(target_.spp); i < n; ++i) m = std::max(m, row[i]);
+      size_t i = 0;
+      for (; i + 4 <= n; i += 4)
+        for (int k = 0; k < 4; ++k) m[k] = std::max(m[k], row[i + size_t(k)]);
+      for (; i < n; ++i) m[0] = std::max(m[0], row[i]);
     }
-    bound_[b] = m;
+    bound_[b] = std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
     stale_[b] = 0;
   }
 
@@ -168,7 +181,8 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     highPos = glm::max(highPos, q);
   }
 
-  // The depth test and write of t at one sample; true when written.
+  // The depth test and write of t at one sample, traced when asked (the
+  // reference and traced walks).
   const auto test = [&](const TriangleSetup& t, uint32_t index, uint64_t id, int px, int py, int s,
                         bool traceHere) {
     const size_t i = target->index(px, py, s);
@@ -185,18 +199,17 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     const bool traced = traceHere && px == trace.pixel.x && py == trace.pixel.y;
     if (traced)
       traceDepthTest(*trace.sink, setups, t, s, key, stored, keysOnly ? kNoSetup : winners[i], pass);
-    if (!pass) return false;
+    if (!pass) return;
     if (alphaTest && !alphaTest(t, px, py, s)) {
       ++counters->alphaRejected;
       if (traced)
         trace.sink->record(TraceEvent{TraceStage::Alpha, s, t.instance, t.triangle, 1, "discarded", {}}.add(
             "coverage", "below the MASK cutoff"));
-      return false;
+      return;
     }
     ++counters->samplesPassed;
     keys[i] = key;
     if (!keysOnly) winners[i] = index;
-    return true;
   };
 
   for (uint32_t index : bin) {
@@ -233,9 +246,8 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         const BlockClass c = classifyBlock(t, scratch, U, b, lo);
         if (c == BlockClass::Reject) continue;
         const size_t hb = bounds.block(bx, by);
-        const uint32_t stored = bounds.bound(hb);
-        if (stored != kClearDepthKey &&
-            std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos)) > stored)
+        if (bounds.culls(
+                hb, [&] { return std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos)); }))
           continue;
         if (c == BlockClass::Accept) {
           const uint64_t full = fullBlockMask(b);
@@ -243,6 +255,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         } else {
           blockMasks(t, scratch, U, spp, b, lo, masks);
         }
+        // The same test as `test` above without the trace (not traced here).
         bool wrote = false;
         for (int s = 0; s < spp; ++s) {
           uint64_t m = masks[s];
@@ -250,7 +263,23 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
           while (m) {
             const int bit = __builtin_ctzll(m);
             m &= m - 1;
-            wrote |= test(t, index, id, b.x + (bit & 7), b.y + (bit >> 3), s, false);
+            const int px = b.x + (bit & 7), py = b.y + (bit >> 3);
+            const size_t i = target->index(px, py, s);
+            const uint32_t key = sampleDepthKey(t, grid, format, px, py, s);
+            const uint32_t stored = keys[i];
+            if (key > stored) continue;
+            if (key == stored &&
+                (keysOnly || !passesDepthTest(func, key, id, stored,
+                                              winners[i] == kNoSetup ? UINT64_MAX : setups[winners[i]].id())))
+              continue;
+            if (alphaTest && !alphaTest(t, px, py, s)) {
+              ++counters->alphaRejected;
+              continue;
+            }
+            ++counters->samplesPassed;
+            keys[i] = key;
+            if (!keysOnly) winners[i] = index;
+            wrote = true;
           }
         }
         if (wrote) bounds.markStale(hb);

@@ -38,7 +38,8 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
         const TriangleSetup& t = setups_[win];
         const uint32_t local = index(px, py, s);
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
-        samples.front[local] = interpolatedHit(t, pos);
+        const SampleHit hit = interpolatedHit(t, pos);
+        samples.front[local] = hit;
         glm::vec4 c;
         if (options_.shadingRate == ShadingRate::Pixel) {
           auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
@@ -47,11 +48,11 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
             c = it->second;
           } else {
             // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
-            c = shadeAt(t, pos, corner + glm::dvec2(0.5), n);
+            c = shadeAt(hit, pos, corner + glm::dvec2(0.5), n);
             pixelCache.emplace_back(t.id(), c);
           }
         } else {
-          c = shadeAt(t, pos, pos, n);
+          c = shadeAt(hit, pos, pos, n);
         }
         samples.color[local] = c;
         if (trace.sink && px == trace.pixel.x && py == trace.pixel.y) {

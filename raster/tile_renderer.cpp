@@ -33,6 +33,7 @@ TileRenderer::TileRenderer(const Scene& scene, const SceneAnalysis& analysis, co
       shader_(shader),
       grid_(grid),
       setups_(setups),
+      rays_(camera),
       centre_(centreSampleIndex(options.spp)) {}
 
 void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarget* target,
@@ -77,7 +78,7 @@ SampleHit TileRenderer::interpolatedHit(const TriangleSetup& t, const glm::dvec2
 // layers alike, and coincident duplicates tie exactly and fall back to
 // (instance, triangle). The interpolated depth when the plane is missed.
 double TileRenderer::planeDepth(const TriangleSetup& t, const glm::dvec2& pos) const {
-  const Ray ray = camera_.primaryRay(pos);
+  const Ray ray = rays_(pos);
   double th;
   glm::dvec2 b;
   if (intersectTrianglePlane(scene_, t.instance, t.triangle, ray, &th, &b) && th > 0.0) {
@@ -89,19 +90,19 @@ double TileRenderer::planeDepth(const TriangleSetup& t, const glm::dvec2& pos) c
 
 // The same inputs the ray caster shades from: the hit refined on the
 // stored triangle's plane along the primary ray through `pos`.
-SurfacePoint TileRenderer::surfaceAt(const TriangleSetup& t, const glm::dvec2& pos, Ray* ray) const {
-  *ray = camera_.primaryRay(pos);
-  return makeSurfacePoint(scene_, refineHit(scene_, *ray, interpolatedHit(t, pos)));
+SurfacePoint TileRenderer::surfaceAt(const SampleHit& hit, const glm::dvec2& pos, Ray* ray) const {
+  *ray = rays_(pos);
+  return makeSurfacePoint(scene_, refineHit(scene_, *ray, hit));
 }
 
 TextureFootprint TileRenderer::footprint(const SurfacePoint& p, const glm::dvec2& pos) const {
   return analysis_.textures ? pixelFootprint(scene_, camera_, p, pos) : TextureFootprint{};
 }
 
-glm::vec4 TileRenderer::shadeAt(const TriangleSetup& t, const glm::dvec2& pos, const glm::dvec2& footprintPos,
+glm::vec4 TileRenderer::shadeAt(const SampleHit& hit, const glm::dvec2& pos, const glm::dvec2& footprintPos,
                                 ThreadCounters& n) const {
   Ray ray;
-  const SurfacePoint p = surfaceAt(t, pos, &ray);
+  const SurfacePoint p = surfaceAt(hit, pos, &ray);
   ++n.shadedSamples;
   return shader_.shade(p, ray.direction, footprint(p, footprintPos));
 }
@@ -111,7 +112,7 @@ bool TileRenderer::alphaCovered(const TriangleSetup& t, int px, int py, int s) c
   if (m.alphaMode != AlphaMode::Mask) return true;
   const glm::dvec2 pos = glm::dvec2(px, py) + grid_.positions[size_t(s)];
   Ray ray;
-  const SurfacePoint p = surfaceAt(t, pos, &ray);
+  const SurfacePoint p = surfaceAt(interpolatedHit(t, pos), pos, &ray);
   return shader_.coverageAlpha(p, footprint(p, pos)) >= m.alphaCutoff;
 }
 

@@ -100,9 +100,10 @@ class TileRenderer {
   // Sampling helpers (tile_renderer.cpp).
   SampleHit interpolatedHit(const TriangleSetup& t, const glm::dvec2& pos) const;
   double planeDepth(const TriangleSetup& t, const glm::dvec2& pos) const;
-  SurfacePoint surfaceAt(const TriangleSetup& t, const glm::dvec2& pos, Ray* ray) const;
+  // `hit`: interpolatedHit at `pos` (computed once by the caller, which keeps it too).
+  SurfacePoint surfaceAt(const SampleHit& hit, const glm::dvec2& pos, Ray* ray) const;
   TextureFootprint footprint(const SurfacePoint& p, const glm::dvec2& pos) const;
-  glm::vec4 shadeAt(const TriangleSetup& t, const glm::dvec2& pos, const glm::dvec2& footprintPos,
+  glm::vec4 shadeAt(const SampleHit& hit, const glm::dvec2& pos, const glm::dvec2& footprintPos,
                     ThreadCounters& n) const;
   bool alphaCovered(const TriangleSetup& t, int px, int py, int s) const;
   glm::dvec2 samplePosition(const TileSampleIndex& index, uint32_t local) const;
@@ -154,6 +155,7 @@ class TileRenderer {
   const Shader& shader_;
   const SampleGrid& grid_;
   const std::vector<TriangleSetup>& setups_;
+  PrimaryRays rays_;  // camera_'s primary rays (bit-identical to Camera::primaryRay)
   int centre_;
 };
 

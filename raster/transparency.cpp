@@ -44,7 +44,8 @@ BlendLayer TileRenderer::shadeLayer(const TileSampleIndex& index, const BlendFra
                                     ThreadCounters& n) const {
   const TriangleSetup& t = setups_[f.setup];
   const glm::dvec2 pos = samplePosition(index, f.local);
-  return BlendLayer{f.local, rank, interpolatedHit(t, pos), shadeAt(t, pos, pos, n)};
+  const SampleHit hit = interpolatedHit(t, pos);
+  return BlendLayer{f.local, rank, hit, shadeAt(hit, pos, pos, n)};
 }
 
 std::vector<BlendLayer> TileRenderer::transparencyPass(const TileSampleIndex& index,
