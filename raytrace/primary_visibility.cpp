@@ -30,8 +30,6 @@ namespace rastray {
 
 namespace {
 
-constexpr int kPacket = 8;
-
 using Clock = std::chrono::steady_clock;
 
 double secondsBetween(Clock::time_point a, Clock::time_point b) {
@@ -51,6 +49,8 @@ struct TileSample {
   int sample;
 };
 
+void traceOrder(int width, int height, int spp, std::vector<uint32_t>* order);
+
 // What one thread reuses from tile to tile (nothing is allocated per ray
 // or per sample once the first tile has grown it), and the seconds its
 // tiles spent in each phase.
@@ -60,6 +60,10 @@ struct TileScratch {
   std::vector<GatheredHit> closest;  // per sample: the stopping hit
   std::vector<SurfaceCrossing> crossings;
   std::vector<glm::vec4> sum;  // per pixel of the tile
+  // The packets' trace order (traceOrder) for tiles of orderSize × orderSpp.
+  std::vector<uint32_t> order;
+  glm::ivec2 orderSize{0};
+  int orderSpp = 0;
   double primarySeconds = 0.0, shadeSeconds = 0.0;
 
   void prepare(const Tile& tile, int spp) {
@@ -70,6 +74,16 @@ struct TileScratch {
     if (gathers.size() < samples.size()) gathers.resize(samples.size());
     if (closest.size() < samples.size()) closest.resize(samples.size());
     sum.assign(size_t(tile.width() * tile.height()), glm::vec4(0.0f));
+  }
+
+  const std::vector<uint32_t>& traceOrderFor(const Tile& tile, int spp) {
+    const glm::ivec2 size(tile.width(), tile.height());
+    if (size != orderSize || spp != orderSpp) {
+      traceOrder(size.x, size.y, spp, &order);
+      orderSize = size;
+      orderSpp = spp;
+    }
+    return order;
   }
 };
 
@@ -85,11 +99,8 @@ void renderTile(const CasterState& state, const Tile& tile, const std::vector<gl
                 int centre, TileScratch& scratch, FlatImage* image, std::vector<DeepSample>* tileDeep,
                 std::vector<uint32_t>* pixelCounts);
 DeepImage assembleDeepImage(int width, int height, int tileSize, int tilesX, const DeepTiles& deep);
-void tracePacket(const CasterState& state, HitGather* gathers, GatheredHit* closest, size_t n);
+void tracePackets(const CasterState& state, TileScratch& scratch);
 void setupPrimary(const CasterState& state, HitGather& g, glm::ivec2 pixel, const glm::dvec2& position);
-void clearPacket(RTCRayHit8& rh, int valid[kPacket]);
-void setLane(RTCRayHit8& rh, int valid[kPacket], size_t i, const Ray& ray);
-GatheredHit laneHit(const RTCRayHit8& rh, size_t i);
 SampleResult resolvePrimary(const CasterState& state, const RayTreeContext& context, HitGather& g,
                             const GatheredHit& closest, uint32_t sampleIndex, std::vector<DeepSample>* deep,
                             std::vector<SurfaceCrossing>* crossings);
@@ -166,9 +177,8 @@ void renderTile(const CasterState& state, const Tile& tile, const std::vector<gl
     for (size_t i = 0; i < n; ++i)
       scratch.closest[i] = intersectClosest(state, scratch.gathers[i], /*coherent=*/true);
   } else {
-    for (size_t first = 0; first < n; first += kPacket)
-      tracePacket(state, &scratch.gathers[first], &scratch.closest[first],
-                  std::min(size_t(kPacket), n - first));
+    scratch.traceOrderFor(tile, spp);
+    tracePackets(state, scratch);
   }
   const Clock::time_point traced = Clock::now();
 
@@ -245,71 +255,122 @@ SampleResult tracePrimarySample(const CasterState& state, const RayTreeContext& 
 
 namespace {
 
-// --- 8-wide packets -----------------------------------------------------------
+// --- coherent packets -------------------------------------------------------
 
-// Up to eight consecutive samples of a tile (rays already set up in
-// `gathers`) in one coherent packet; lane i's filters gather into
-// gathers[i], its stopping hit goes to closest[i].
-void tracePacket(const CasterState& state, HitGather* gathers, GatheredHit* closest, size_t n) {
-  alignas(32) int valid[kPacket];
-  alignas(32) RTCRayHit8 rh;
-  clearPacket(rh, valid);
-  for (size_t i = 0; i < n; ++i) setLane(rh, valid, i, gathers[i].ray);
-  GatherContext gatherContext;
-  rtcInitIntersectContext(&gatherContext.embree);
-  gatherContext.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  gatherContext.gathers = gathers;
-  {
-    FlushDenormalsScope ftz;
-    rtcIntersect8(valid, state.embree->handle(), &gatherContext.embree, &rh);
+// Embree's packet of N rays: its type and call.
+template <int N>
+struct Packet;
+template <>
+struct Packet<4> {
+  using RayHit = RTCRayHit4;
+  static void intersect(const int* valid, RTCScene scene, RTCIntersectContext* context, RayHit* rh) {
+    rtcIntersect4(valid, scene, context, rh);
   }
-  for (size_t i = 0; i < n; ++i) closest[i] = laneHit(rh, i);
+};
+template <>
+struct Packet<8> {
+  using RayHit = RTCRayHit8;
+  static void intersect(const int* valid, RTCScene scene, RTCIntersectContext* context, RayHit* rh) {
+    rtcIntersect8(valid, scene, context, rh);
+  }
+};
+template <>
+struct Packet<16> {
+  using RayHit = RTCRayHit16;
+  static void intersect(const int* valid, RTCScene scene, RTCIntersectContext* context, RayHit* rh) {
+    rtcIntersect16(valid, scene, context, rh);
+  }
+};
+
+// Morton (Z) order of the bits of x and y, interleaved.
+uint32_t mortonCode(uint32_t x, uint32_t y) {
+  uint32_t code = 0;
+  for (uint32_t bit = 0; bit < 16; ++bit)
+    code |= ((x >> bit) & 1u) << (2 * bit) | ((y >> bit) & 1u) << (2 * bit + 1);
+  return code;
 }
 
-// Lanes without a sample: invalid, and a harmless ray should Embree read them.
-void clearPacket(RTCRayHit8& rh, int valid[kPacket]) {
-  for (int i = 0; i < kPacket; ++i) {
-    valid[i] = 0;
-    rh.ray.org_x[i] = rh.ray.org_y[i] = rh.ray.org_z[i] = 0.0f;
-    rh.ray.dir_x[i] = rh.ray.dir_y[i] = 0.0f;
-    rh.ray.dir_z[i] = -1.0f;
-    rh.ray.tnear[i] = 0.0f;
-    rh.ray.tfar[i] = -kInf;
+// The order packets trace a tile's samples in (indices into the tile's
+// pixel-order samples): pixels in Morton order, each pixel's samples
+// together, so a packet's lanes cover a compact block (16 lanes at 1 spp:
+// 4×4 pixels; 8 lanes: 4×2) rather than a strip of a row.
+void traceOrder(int width, int height, int spp, std::vector<uint32_t>* order) {
+  std::vector<std::pair<uint32_t, uint32_t>> pixels;  // (Morton code, pixel index)
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      pixels.push_back({mortonCode(uint32_t(x), uint32_t(y)), uint32_t(y * width + x)});
+  std::sort(pixels.begin(), pixels.end());
+  order->clear();
+  for (const auto& p : pixels)
+    for (int s = 0; s < spp; ++s) order->push_back(p.second * uint32_t(spp) + uint32_t(s));
+}
+
+// Up to N samples of the tile (set up in scratch.gathers) in one coherent
+// packet. Each lane's ray id is its sample's index, so the filters gather
+// into that sample's HitGather; its stopping hit goes to scratch.closest.
+template <int N>
+void tracePacket(const CasterState& state, TileScratch& scratch, const uint32_t* samples, size_t n) {
+  using P = Packet<N>;
+  alignas(64) int valid[N];
+  alignas(64) typename P::RayHit rh;
+  for (size_t i = 0; i < size_t(N); ++i) {
+    // Lanes without a sample: invalid, and a harmless ray should Embree read them.
+    const bool used = i < n;
+    const Ray* ray = used ? &scratch.gathers[samples[i]].ray : nullptr;
+    const glm::vec3 o = used ? glm::vec3(ray->origin) : glm::vec3(0.0f);
+    const glm::vec3 d = used ? glm::vec3(ray->direction) : glm::vec3(0.0f, 0.0f, -1.0f);
+    valid[i] = used ? -1 : 0;
+    rh.ray.org_x[i] = o.x;
+    rh.ray.org_y[i] = o.y;
+    rh.ray.org_z[i] = o.z;
+    rh.ray.dir_x[i] = d.x;
+    rh.ray.dir_y[i] = d.y;
+    rh.ray.dir_z[i] = d.z;
+    rh.ray.tnear[i] = used ? float(ray->tNear) : 0.0f;
+    rh.ray.tfar[i] = used ? float(ray->tFar) : -kInf;
     rh.ray.time[i] = 0.0f;
     rh.ray.mask[i] = 0xFFFFFFFFu;
-    rh.ray.id[i] = unsigned(i);
+    rh.ray.id[i] = used ? samples[i] : 0u;
     rh.ray.flags[i] = 0;
     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.u[i] = rh.hit.v[i] = 0.0f;
-    rh.hit.Ng_x[i] = rh.hit.Ng_y[i] = rh.hit.Ng_z[i] = 0.0f;
+  }
+  GatherContext gatherContext;
+  rtcInitIntersectContext(&gatherContext.embree);
+  gatherContext.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  gatherContext.gathers = scratch.gathers.data();
+  {
+    FlushDenormalsScope ftz;
+    P::intersect(valid, state.embree->handle(), &gatherContext.embree, &rh);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    GatheredHit& closest = scratch.closest[samples[i]];
+    closest = GatheredHit{};
+    if (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID) {
+      closest.traversalT = rh.ray.tfar[i];
+      closest.instance = rh.hit.geomID[i];
+      closest.triangle = rh.hit.primID[i];
+      closest.u = rh.hit.u[i];
+      closest.v = rh.hit.v[i];
+    }
   }
 }
 
-void setLane(RTCRayHit8& rh, int valid[kPacket], size_t i, const Ray& ray) {
-  const glm::vec3 o(ray.origin), d(ray.direction);
-  valid[i] = -1;
-  rh.ray.org_x[i] = o.x;
-  rh.ray.org_y[i] = o.y;
-  rh.ray.org_z[i] = o.z;
-  rh.ray.dir_x[i] = d.x;
-  rh.ray.dir_y[i] = d.y;
-  rh.ray.dir_z[i] = d.z;
-  rh.ray.tnear[i] = float(ray.tNear);
-  rh.ray.tfar[i] = float(ray.tFar);
-}
-
-GatheredHit laneHit(const RTCRayHit8& rh, size_t i) {
-  GatheredHit closest;
-  if (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID) {
-    closest.traversalT = rh.ray.tfar[i];
-    closest.instance = rh.hit.geomID[i];
-    closest.triangle = rh.hit.primID[i];
-    closest.u = rh.hit.u[i];
-    closest.v = rh.hit.v[i];
+// Every sample of the tile in packets of RayOptions::packetWidth, in
+// scratch.order.
+void tracePackets(const CasterState& state, TileScratch& scratch) {
+  const size_t width = size_t(state.options.packetWidth), n = scratch.order.size();
+  for (size_t first = 0; first < n; first += width) {
+    const uint32_t* samples = &scratch.order[first];
+    const size_t count = std::min(width, n - first);
+    if (width == 4)
+      tracePacket<4>(state, scratch, samples, count);
+    else if (width == 16)
+      tracePacket<16>(state, scratch, samples, count);
+    else
+      tracePacket<8>(state, scratch, samples, count);
   }
-  return closest;
 }
 
 void setupPrimary(const CasterState& state, HitGather& g, glm::ivec2 pixel, const glm::dvec2& position) {

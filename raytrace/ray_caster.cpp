@@ -19,8 +19,10 @@ const char* kCounterNames[kRayKindCount] = {"rays.primary", "rays.shadow", "rays
 
 // What render() did and left out, with the analysis's reasons.
 void reportPasses(const CasterState& state, RenderOutput* out) {
-  out->passesRun.push_back("primary rays (" +
-                           std::string(usePackets(state) ? "8-wide packets" : "single rays") + ")");
+  out->passesRun.push_back(
+      "primary rays (" +
+      (usePackets(state) ? std::to_string(state.options.packetWidth) + "-wide packets" : "single rays") +
+      ")");
   const SceneAnalysis& a = state.analysis;
   auto pass = [&](bool needed, const std::string& name, Work work) {
     if (needed)
@@ -152,6 +154,8 @@ void RayCaster::bind(const Camera& camera, const RayOptions& options) {
         "command line", "--spp",
         "unsupported sample count " + std::to_string(options.spp) + " (use " + supportedSampleCounts() + ")");
   if (options.shading.maxDepth < 0) throw InputError("command line", "--max-depth", "must be >= 0");
+  RASTRAY_CHECK(options.packetWidth == 4 || options.packetWidth == 8 || options.packetWidth == 16,
+                "RayOptions::packetWidth must be 4, 8 or 16");
   CasterState& state = *impl_;
   state.camera = camera;
   state.primaryRays.emplace(state.camera);

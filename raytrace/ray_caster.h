@@ -135,6 +135,9 @@ struct RayOptions {
   // scalar reference path).
   bool packets = true;
   bool forcePackets = false;
+  // Rays per packet: 4, 8 or 16 (rtcIntersect4/8/16), each packet a compact
+  // block of pixels (Morton order within the tile).
+  int packetWidth = 16;
   int tileSize = 16;  // pixels per side of a parallel work item
   // render() records the ray tree of trace.pixel (TraceStage::Ray events,
   // one per ray: rayTraceEvent) into trace.sink after the image.

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "common/math_constants.h"
 #include <tbb/parallel_for.h>
+#include "common/math_constants.h"
 
 #include <cmath>
 #include <cstdio>
@@ -295,30 +295,62 @@ TEST(DeepSamples, LayersCompositeToTheFlatPixel) {
 
 // --- packets against single rays ------------------------------------------------------
 
+// Every packet width, at 1 and 4 spp (packets then hold whole pixels'
+// samples in Morton order), gives the scalar reference path's hits:
+// colours, Z, IDs, every deep sample, and the counters. The one exception
+// is Embree's: when a ray meets two triangles at exactly the same t (a ray
+// through a shared edge or a corner where walls meet, which pixel centres
+// at 1 spp on the symmetric Cornell box do), the first one its traversal
+// finds is kept, and packet and single-ray traversal visit nodes in
+// different orders. Such samples have the same Z and other IDs; the 4 spp
+// sample positions meet no tie on these scenes, so there everything agrees.
 TEST(Packets, AgreeWithSingleRays) {
   for (const char* name :
        {"cornell-box.gltf", "transparent-layers.gltf", "three-triangles.gltf", "textured-plane.gltf"}) {
     const Scene scene = loadScene(scenePath(name));
-    RayOptions options;
-    options.spp = 4;
-    options.keepSamples = true;
-    options.packets = true;
-    options.forcePackets = true;
-    const RenderOutput packets = renderScene(scene, 48, 40, options);
-    options.packets = false;
-    const RenderOutput single = renderScene(scene, 48, 40, options);
-    size_t differ = 0;
-    for (size_t i = 0; i < packets.image.color.size(); ++i)
-      if (packets.image.color[i] != single.image.color[i] ||
-          packets.image.instance[i] != single.image.instance[i] ||
-          packets.image.triangle[i] != single.image.triangle[i] ||
-          !(packets.image.depth[i] == single.image.depth[i] ||
-            (std::isinf(packets.image.depth[i]) && std::isinf(single.image.depth[i]))))
-        ++differ;
-    EXPECT_EQ(differ, 0u) << name;
-    EXPECT_EQ(packets.samples.samples.size(), single.samples.samples.size()) << name;
-    for (const char* counter : kRayCounters)
-      EXPECT_EQ(packets.counters.get(counter), single.counters.get(counter)) << name << " " << counter;
+    for (int spp : {1, 4}) {
+      RayOptions options;
+      options.spp = spp;
+      options.keepSamples = true;
+      options.packets = false;
+      const RenderOutput single = renderScene(scene, 48, 40, options);
+      for (int width : {4, 8, 16}) {
+        options.packets = true;
+        options.forcePackets = true;
+        options.packetWidth = width;
+        const RenderOutput packets = renderScene(scene, 48, 40, options);
+        const std::string what =
+            std::string(name) + " spp " + std::to_string(spp) + " width " + std::to_string(width);
+        size_t differ = 0, ties = 0;
+        for (size_t i = 0; i < packets.image.color.size(); ++i) {
+          const bool sameIds = packets.image.instance[i] == single.image.instance[i] &&
+                               packets.image.triangle[i] == single.image.triangle[i];
+          const bool sameDepth = packets.image.depth[i] == single.image.depth[i] ||
+                                 (std::isinf(packets.image.depth[i]) && std::isinf(single.image.depth[i]));
+          if (sameIds && sameDepth && packets.image.color[i] == single.image.color[i]) continue;
+          const bool tie = !sameIds && sameDepth && std::isfinite(packets.image.depth[i]) &&
+                           packets.image.instance[i] != kNoId && single.image.instance[i] != kNoId;
+          ties += tie;
+          differ += !tie;
+        }
+        EXPECT_EQ(differ, 0u) << what << ": pixels differ other than by an exact tie";
+        if (spp == 4) EXPECT_EQ(ties, 0u) << what;
+        EXPECT_EQ(packets.samples.offsets, single.samples.offsets) << what;
+        ASSERT_EQ(packets.samples.samples.size(), single.samples.samples.size()) << what;
+        size_t deepDiffer = 0;
+        for (size_t i = 0; i < packets.samples.samples.size(); ++i) {
+          const DeepSample &a = packets.samples.samples[i], &b = single.samples.samples[i];
+          const bool same = a.color == b.color && a.depth == b.depth && a.instance == b.instance &&
+                            a.triangle == b.triangle && a.sample == b.sample && a.cutOff == b.cutOff;
+          const bool tie = a.depth == b.depth && a.sample == b.sample &&
+                           (a.instance != b.instance || a.triangle != b.triangle);
+          deepDiffer += !same && !(spp == 1 && tie);
+        }
+        EXPECT_EQ(deepDiffer, 0u) << what;
+        for (const char* counter : kRayCounters)
+          EXPECT_EQ(packets.counters.get(counter), single.counters.get(counter)) << what << " " << counter;
+      }
+    }
   }
 }
 
