@@ -1,11 +1,11 @@
 // Primary visibility: the image in tiles of tileSize² pixels in parallel
 // (TBB). A tile runs in two phases: first every (pixel, sample) pair's
-// primary ray is traced, as single rays or eight at a time in coherent
-// packets (rtcIntersect8); then each ray's surfaces are collected and
-// shaded (radiance.cpp, secondary rays included) and the samples are
-// box-filtered into the flat image. The deep output keeps every sample's
-// surfaces, per tile in one buffer, and is assembled into one flat
-// DeepImage at the end.
+// primary ray is traced, as single rays or in coherent packets of 4, 8 or
+// 16 (rtcIntersect4/8/16) in Morton order; then each ray's surfaces are
+// collected and shaded (radiance.cpp, secondary rays included) and the
+// samples are box-filtered into the flat image. The deep output keeps
+// every sample's surfaces, per tile in one buffer, and is assembled into
+// one flat DeepImage at the end.
 //
 // Timings (RenderOutput::timings): each tile reads the clock three times,
 // and each thread sums the seconds of its tiles' two phases. The wall time
@@ -43,7 +43,7 @@ struct Tile {
 };
 
 // One primary sample of a tile. A tile's samples run in pixel order (then
-// sample order); packets take eight consecutive ones.
+// sample order); packets take them in traceOrder.
 struct TileSample {
   glm::ivec2 pixel;
   int sample;

@@ -4,7 +4,7 @@
 //   ray_caster.cpp          RayCaster: binding, the report of passes,
 //                           counters, and the traced pixel (its ray tree as
 //                           records and as trace events)
-//   primary_visibility.cpp  primary rays: tiles in parallel, 8-wide packets
+//   primary_visibility.cpp  primary rays: tiles in parallel, coherent packets
 //                           or single rays, the flat and deep output
 //   radiance.cpp            the recursive radiance integrator: a ray's
 //                           surfaces composited front to back through the
@@ -319,7 +319,7 @@ glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& con
 
 // --- primary visibility (primary_visibility.cpp) ------------------------------
 
-// Whether primary rays go in 8-wide packets (RayOptions::packets).
+// Whether primary rays go in packets (RayOptions::packets, packetWidth).
 bool usePackets(const CasterState& state);
 
 // The image: every sample's primary ray tree, filtered into the flat
