@@ -14,6 +14,10 @@
 #include <cstdio>
 #include <string>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "raster/coverage.h"
 
 namespace rastray {
@@ -43,6 +47,28 @@ void traceDepthTest(TraceSink& sink, const std::vector<TriangleSetup>& setups, c
   e.add("stored_instance", winner == kNoSetup ? "-1" : std::to_string(setups[winner].instance));
   e.add("stored_triangle", winner == kNoSetup ? "-1" : std::to_string(setups[winner].triangle));
   sink.record(std::move(e));
+}
+
+// The largest of n keys.
+uint32_t maxKey(const uint32_t* keys, size_t n) {
+  size_t i = 0;
+  uint32_t m = 0;
+#if defined(__SSE2__)
+  // SSE2 has no unsigned 32-bit max: flip the sign bits, compare signed,
+  // select, flip back.
+  const __m128i flip = _mm_set1_epi32(int32_t(0x80000000u));
+  __m128i acc = flip;  // 0 flipped
+  for (; i + 4 <= n; i += 4) {
+    const __m128i k = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(keys + i)), flip);
+    const __m128i gt = _mm_cmpgt_epi32(k, acc);
+    acc = _mm_or_si128(_mm_and_si128(gt, k), _mm_andnot_si128(gt, acc));
+  }
+  alignas(16) uint32_t lanes[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(lanes), _mm_xor_si128(acc, flip));
+  m = std::max(std::max(lanes[0], lanes[1]), std::max(lanes[2], lanes[3]));
+#endif
+  for (; i < n; ++i) m = std::max(m, keys[i]);
+  return m;
 }
 
 // Per block of the rect (kCoverageBlock² pixels aligned to its corner): an
@@ -76,6 +102,18 @@ class BlockDepthBounds {
     return lowest > bound_[b];
   }
   void markStale(size_t b) { stale_[b] = 1; }
+  // Every sample of block b was just written, the largest key being `key`.
+  void setExact(size_t b, uint32_t key) {
+    bound_[b] = key;
+    stale_[b] = 0;
+  }
+  // Whether b (a block clipped to a triangle's bounds) is the whole of its block of the rect.
+  bool wholeBlock(const PixelBlock& b) const {
+    const int bx = rect_.x0 + (b.x - rect_.x0) / kCoverageBlock * kCoverageBlock;
+    const int by = rect_.y0 + (b.y - rect_.y0) / kCoverageBlock * kCoverageBlock;
+    return b.x == bx && b.y == by && b.w == std::min(kCoverageBlock, rect_.x1 - bx) &&
+           b.h == std::min(kCoverageBlock, rect_.y1 - by);
+  }
   void markStale(const PixelBounds& r) {
     constexpr int B = kCoverageBlock;
     for (int y = rect_.y0 + (r.y0 - rect_.y0) / B * B; y <= r.y1; y += B)
@@ -87,17 +125,10 @@ class BlockDepthBounds {
     const int x0 = rect_.x0 + int(b % size_t(columns_)) * kCoverageBlock;
     const int y0 = rect_.y0 + int(b / size_t(columns_)) * kCoverageBlock;
     const int x1 = std::min(x0 + kCoverageBlock, rect_.x1), y1 = std::min(y0 + kCoverageBlock, rect_.y1);
-    // Four running maxima: independent chains, not one long dependency.
-    uint32_t m[4] = {0, 0, 0, 0};
     const size_t n = size_t(x1 - x0) * size_t(target_.spp);
-    for (int y = y0; y < y1; ++y) {
-      const uint32_t* row = &target_.keys[target_.index(x0, y, 0)];
-      size_t i = 0;
-      for (; i + 4 <= n; i += 4)
-        for (int k = 0; k < 4; ++k) m[k] = std::max(m[k], row[i + size_t(k)]);
-      for (; i < n; ++i) m[0] = std::max(m[0], row[i]);
-    }
-    bound_[b] = std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+    uint32_t m = 0;
+    for (int y = y0; y < y1; ++y) m = std::max(m, maxKey(&target_.keys[target_.index(x0, y, 0)], n));
+    bound_[b] = m;
     stale_[b] = 0;
   }
 
@@ -256,7 +287,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
           blockMasks(t, scratch, U, spp, b, lo, masks);
         }
         // The same test as `test` above without the trace (not traced here).
-        bool wrote = false;
+        uint32_t written = 0, writtenMax = 0;
         for (int s = 0; s < spp; ++s) {
           uint64_t m = masks[s];
           counters->samplesTested += uint64_t(__builtin_popcountll(m));
@@ -279,10 +310,15 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
             ++counters->samplesPassed;
             keys[i] = key;
             if (!keysOnly) winners[i] = index;
-            wrote = true;
+            ++written;
+            writtenMax = std::max(writtenMax, key);
           }
         }
-        if (wrote) bounds.markStale(hb);
+        if (written == 0) continue;
+        if (c == BlockClass::Accept && written == uint32_t(b.w * b.h * spp) && bounds.wholeBlock(b))
+          bounds.setExact(hb, writtenMax);  // every key of the block is new
+        else
+          bounds.markStale(hb);
       }
   }
 }

@@ -21,7 +21,7 @@ void TileRenderer::opaquePass(const TileRect& rect, const std::vector<uint32_t>&
 }
 
 TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,
-                                       const TraceRequest& trace, ThreadCounters& n) const {
+                                       const TraceRequest& trace, bool allFronts, ThreadCounters& n) const {
   const TileRect& rect = index.rect;
   const int spp = grid_.spp;
   TileSamples samples;
@@ -38,24 +38,30 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
         const TriangleSetup& t = setups_[win];
         const uint32_t local = index(px, py, s);
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
-        const SampleHit hit = interpolatedHit(t, pos);
-        samples.front[local] = hit;
+        const bool traced = trace.sink && px == trace.pixel.x && py == trace.pixel.y;
         glm::vec4 c;
         if (options_.shadingRate == ShadingRate::Pixel) {
           auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
                                  [&](const auto& e) { return e.first == t.id(); });
           if (it != pixelCache.end()) {
             c = it->second;
+            // The sample's own hit only where someone reads it: the
+            // resolve's centre sample, the per-sample hits, the trace.
+            if (allFronts || s == centre_ || traced) samples.front[local] = interpolatedHit(t, pos);
           } else {
             // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
+            const SampleHit hit = interpolatedHit(t, pos);
+            samples.front[local] = hit;
             c = shadeAt(hit, pos, corner + glm::dvec2(0.5), n);
             pixelCache.emplace_back(t.id(), c);
           }
         } else {
+          const SampleHit hit = interpolatedHit(t, pos);
+          samples.front[local] = hit;
           c = shadeAt(hit, pos, pos, n);
         }
         samples.color[local] = c;
-        if (trace.sink && px == trace.pixel.x && py == trace.pixel.y) {
+        if (traced) {
           const SampleHit& h = samples.front[local];
           char b[64];
           std::snprintf(b, sizeof b, "(%.6f, %.6f)", double(h.b1), double(h.b2));

@@ -55,7 +55,7 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
   }
 
   opaquePass(rect, bins.opaque, trace, target, n);
-  TileSamples samples = shadeVisible(index, *target, trace, n);
+  TileSamples samples = shadeVisible(index, *target, trace, out.hits != nullptr, n);
   std::vector<BlendLayer> layers;
   if (bins.blend && !bins.blend->empty()) layers = transparencyPass(index, *bins.blend, *target, n);
   const std::vector<glm::vec4> opaqueColor = compositeLayers(layers, &samples);

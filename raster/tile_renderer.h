@@ -114,8 +114,11 @@ class TileRenderer {
   // Pass 1 (opaque_pass.cpp).
   void opaquePass(const TileRect& rect, const std::vector<uint32_t>& bin, const TraceRequest& trace,
                   DepthTarget* target, ThreadCounters& n) const;
+  // `allFronts`: every sample's front hit is read (per-sample hits out);
+  // else only the centre sample's and the traced pixel's need to be set
+  // where shading once per pixel reuses a colour.
   TileSamples shadeVisible(const TileSampleIndex& index, const DepthTarget& target, const TraceRequest& trace,
-                           ThreadCounters& n) const;
+                           bool allFronts, ThreadCounters& n) const;
 
   // Pass 2 (transparency.cpp): layers sorted by local index, front to back
   // within a sample.
