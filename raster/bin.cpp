@@ -13,4 +13,12 @@ TileRect TileGrid::rect(int tile) const {
           std::min(height, (ty + 1) * kTileSize)};
 }
 
+SampleBox::SampleBox(const SampleGrid& grid) {
+  lo = hi = grid.offsets.empty() ? glm::i64vec2(0) : grid.offsets[0];
+  for (const glm::i64vec2& o : grid.offsets) {
+    lo = glm::min(lo, o);
+    hi = glm::max(hi, o);
+  }
+}
+
 }  // namespace rastray

@@ -2,8 +2,19 @@
 // kTileSize × kTileSize pixels and are rasterized independently (in
 // parallel); each bin lists setup indices in increasing order, so a tile
 // sees its triangles in the same order whatever the thread count.
+//
+// A triangle is binned to the tiles its pixel bounds overlap, less those
+// that one of its edges misses entirely: E + bias < 0 at the sample-box
+// corner where E is largest means no sample of the tile (within the
+// triangle's bounds) is covered. The corner lies inside the image, so the
+// value is within setup.h's int64 bound and the test is exact.
 #pragma once
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
@@ -26,20 +37,83 @@ struct TileGrid {
   TileRect rect(int tile) const;
 };
 
-// bins[tile] = indices into `setups` (those accepted by `select`) whose
-// pixel bounds overlap the tile.
-template <typename Select>
-std::vector<std::vector<uint32_t>> binTriangles(const TileGrid& grid,
-                                                const std::vector<TriangleSetup>& setups, Select select) {
-  std::vector<std::vector<uint32_t>> bins(size_t(grid.count()));
-  for (size_t i = 0; i < setups.size(); ++i) {
-    const TriangleSetup& t = setups[i];
-    if (!select(t)) continue;
-    const int tx0 = t.pixelMin.x / kTileSize, tx1 = t.pixelMax.x / kTileSize;
-    const int ty0 = t.pixelMin.y / kTileSize, ty1 = t.pixelMax.y / kTileSize;
-    for (int ty = ty0; ty <= ty1; ++ty)
-      for (int tx = tx0; tx <= tx1; ++tx) bins[size_t(ty * grid.tilesX + tx)].push_back(uint32_t(i));
+// The extremes of a pattern's sample offsets within a pixel (units).
+struct SampleBox {
+  glm::i64vec2 lo{0}, hi{0};
+  explicit SampleBox(const SampleGrid& grid);
+};
+
+// Whether some sample of pixels [x0, x1] × [y0, y1] (inclusive) might be
+// covered by t: false only when one edge is negative at all of them.
+inline bool edgesReach(const TriangleSetup& t, int64_t unitsPerPixel, const SampleBox& box, int x0, int y0,
+                       int x1, int y1) {
+  const int64_t X0 = int64_t(x0) * unitsPerPixel + box.lo.x, X1 = int64_t(x1) * unitsPerPixel + box.hi.x;
+  const int64_t Y0 = int64_t(y0) * unitsPerPixel + box.lo.y, Y1 = int64_t(y1) * unitsPerPixel + box.hi.y;
+  for (const EdgeFunction& e : t.edge)
+    if (e.at(e.a > 0 ? X1 : X0, e.b > 0 ? Y1 : Y0) + e.bias < 0) return false;
+  return true;
+}
+
+// Calls f(tile) for every tile t is binned to, in increasing tile order.
+template <typename F>
+void forEachBinnedTile(const TileGrid& grid, int64_t unitsPerPixel, const SampleBox& box,
+                       const TriangleSetup& t, F&& f) {
+  const int tx0 = t.pixelMin.x / kTileSize, tx1 = t.pixelMax.x / kTileSize;
+  const int ty0 = t.pixelMin.y / kTileSize, ty1 = t.pixelMax.y / kTileSize;
+  if (tx0 == tx1 && ty0 == ty1) {  // within one tile: its bounds overlap it, nothing to test
+    f(ty0 * grid.tilesX + tx0);
+    return;
   }
+  for (int ty = ty0; ty <= ty1; ++ty) {
+    const int y0 = std::max(ty * kTileSize, t.pixelMin.y),
+              y1 = std::min(ty * kTileSize + kTileSize - 1, t.pixelMax.y);
+    for (int tx = tx0; tx <= tx1; ++tx) {
+      const int x0 = std::max(tx * kTileSize, t.pixelMin.x),
+                x1 = std::min(tx * kTileSize + kTileSize - 1, t.pixelMax.x);
+      if (edgesReach(t, unitsPerPixel, box, x0, y0, x1, y1)) f(ty * grid.tilesX + tx);
+    }
+  }
+}
+
+// bins[tile] = indices into `setups` (those accepted by `select`) binned to
+// the tile, increasing. In parallel: per-chunk counts, exact bin sizes
+// from their prefix sums in chunk order, then each chunk fills its own
+// slots, so the bins are the serial result whatever the thread count.
+template <typename Select>
+std::vector<std::vector<uint32_t>> binTriangles(const TileGrid& grid, const SampleGrid& samples,
+                                                const std::vector<TriangleSetup>& setups, Select select) {
+  const size_t tiles = size_t(grid.count());
+  std::vector<std::vector<uint32_t>> bins(tiles);
+  if (setups.empty()) return bins;
+  // Few enough chunks that the counts (chunks × tiles) stay small.
+  const size_t maxChunks = 16 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+  const size_t chunks = std::min(maxChunks, (setups.size() + 4095) / 4096);
+  const size_t perChunk = (setups.size() + chunks - 1) / chunks;
+  const SampleBox box(samples);
+  const int64_t U = samples.unitsPerPixel;
+  std::vector<uint32_t> slot(chunks * tiles, 0);  // counts, then each chunk's next slot per tile
+  const auto forChunks = [&](auto&& body) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t c = r.begin(); c != r.end(); ++c) {
+        uint32_t* s = slot.data() + c * tiles;
+        const size_t end = std::min(setups.size(), (c + 1) * perChunk);
+        for (size_t i = c * perChunk; i < end; ++i)
+          if (select(setups[i]))
+            forEachBinnedTile(grid, U, box, setups[i], [&](int tile) { body(s, tile, i); });
+      }
+    });
+  };
+  forChunks([&](uint32_t* s, int tile, size_t) { ++s[tile]; });
+  for (size_t tile = 0; tile < tiles; ++tile) {
+    uint32_t total = 0;
+    for (size_t c = 0; c < chunks; ++c) {
+      const uint32_t n = slot[c * tiles + tile];
+      slot[c * tiles + tile] = total;
+      total += n;
+    }
+    bins[tile].resize(total);
+  }
+  forChunks([&](uint32_t* s, int tile, size_t i) { bins[size_t(tile)][s[tile]++] = uint32_t(i); });
   return bins;
 }
 

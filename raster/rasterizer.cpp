@@ -108,9 +108,10 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   const auto isBlend = [&](const TriangleSetup& t) {
     return scene.materialOf(t.instance).alphaMode == AlphaMode::Blend;
   };
-  const auto opaqueBins = binTriangles(tiles, setups, [&](const TriangleSetup& t) { return !isBlend(t); });
+  const auto opaqueBins =
+      binTriangles(tiles, grid, setups, [&](const TriangleSetup& t) { return !isBlend(t); });
   std::vector<std::vector<uint32_t>> blendBins;
-  if (analysis.transparency) blendBins = binTriangles(tiles, setups, isBlend);
+  if (analysis.transparency) blendBins = binTriangles(tiles, grid, setups, isBlend);
   out.timings.emplace_back("raster.bin", secondsSince(start));
 
   const LightSetup lights = prepareLights(scene, analysis, camera, options, visibility, &out);

@@ -1,10 +1,11 @@
 #include "raster/setup.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <stdexcept>
 
@@ -47,14 +48,18 @@ SampleGrid makeSampleGrid(int spp, int width, int height) {
 
 namespace {
 
-Plane makePlane(const double x[3], const double y[3], const double a[3], double area2) {
-  Plane p;
-  p.x0 = x[0];
-  p.y0 = y[0];
+// The plane through (x[i], y[i], a[i]), with its origin at vertex 0.
+PlaneCoefficients makeCoefficients(const double x[3], const double y[3], const double a[3], double area2) {
+  PlaneCoefficients p;
   p.v0 = a[0];
   p.dx = ((a[1] - a[0]) * (y[2] - y[0]) - (a[2] - a[0]) * (y[1] - y[0])) / area2;
   p.dy = ((a[2] - a[0]) * (x[1] - x[0]) - (a[1] - a[0]) * (x[2] - x[0])) / area2;
   return p;
+}
+
+Plane makePlane(const double x[3], const double y[3], const double a[3], double area2) {
+  const PlaneCoefficients c = makeCoefficients(x, y, a, area2);
+  return {c.v0, c.dx, c.dy, x[0], y[0]};
 }
 
 int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
@@ -82,36 +87,40 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
   if ((cull == CullMode::Back && !t->frontFacing) || (cull == CullMode::Front && t->frontFacing))
     return SetupOutcome::Culled;
 
-  // Reorder to positive area: swap vertices 1 and 2 of front faces.
-  const int order[3] = {0, area2 > 0 ? 1 : 2, area2 > 0 ? 2 : 1};
-  const ClipVertex* cv[3];
-  for (int i = 0; i < 3; ++i) {
-    t->vertex[i] = snapped[order[i]];
-    cv[i] = &v[order[i]];
-    t->bary[i] = cv[i]->bary;
-  }
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3;
-    EdgeFunction& e = t->edge[i];
-    const int64_t dx = t->vertex[j].x - t->vertex[i].x, dy = t->vertex[j].y - t->vertex[i].y;
-    e.a = -dy;
-    e.b = dx;
-    e.c = -(e.a * t->vertex[i].x + e.b * t->vertex[i].y);
-    e.topLeft = (dy == 0 && dx > 0) || dy < 0;
-    e.bias = e.topLeft ? 0 : -1;
-    e.original = false;
-    for (int k = 0; k < 3; ++k)
-      if (t->bary[i][k] == 0.0 && t->bary[j][k] == 0.0) e.original = true;
-  }
-
-  const int64_t minX = std::min({t->vertex[0].x, t->vertex[1].x, t->vertex[2].x});
-  const int64_t maxX = std::max({t->vertex[0].x, t->vertex[1].x, t->vertex[2].x});
-  const int64_t minY = std::min({t->vertex[0].y, t->vertex[1].y, t->vertex[2].y});
-  const int64_t maxY = std::max({t->vertex[0].y, t->vertex[1].y, t->vertex[2].y});
+  // Pixel bounds before any further work: triangles inside the guard band
+  // but off the image (most of a scene for a cube-map face) stop here.
+  const int64_t minX = std::min({snapped[0].x, snapped[1].x, snapped[2].x});
+  const int64_t maxX = std::max({snapped[0].x, snapped[1].x, snapped[2].x});
+  const int64_t minY = std::min({snapped[0].y, snapped[1].y, snapped[2].y});
+  const int64_t maxY = std::max({snapped[0].y, snapped[1].y, snapped[2].y});
   t->pixelMin = {int(std::clamp<int64_t>(floorDiv(minX, grid.unitsPerPixel), 0, space.width)),
                  int(std::clamp<int64_t>(floorDiv(minY, grid.unitsPerPixel), 0, space.height))};
   t->pixelMax = {int(std::clamp<int64_t>(floorDiv(maxX, grid.unitsPerPixel), -1, space.width - 1)),
                  int(std::clamp<int64_t>(floorDiv(maxY, grid.unitsPerPixel), -1, space.height - 1))};
+  if (t->pixelMin.x > t->pixelMax.x || t->pixelMin.y > t->pixelMax.y) return SetupOutcome::Offscreen;
+
+  // Reorder to positive area: swap vertices 1 and 2 of front faces.
+  const int order[3] = {0, area2 > 0 ? 1 : 2, area2 > 0 ? 2 : 1};
+  const ClipVertex* cv[3];
+  for (int i = 0; i < 3; ++i) {
+    // |X|, |Y| <= 2^29 after the clamp: exact in int32.
+    t->vertex[i] = glm::ivec2(snapped[order[i]]);
+    cv[i] = &v[order[i]];
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    EdgeFunction& e = t->edge[i];
+    const int64_t x0 = t->vertex[i].x, y0 = t->vertex[i].y;
+    const int64_t dx = t->vertex[j].x - x0, dy = t->vertex[j].y - y0;
+    e.a = int32_t(-dy);  // |dy| <= 2^30 (setup.h)
+    e.b = int32_t(dx);
+    e.c = -(-dy * x0 + dx * y0);
+    e.topLeft = (dy == 0 && dx > 0) || dy < 0;
+    e.bias = e.topLeft ? 0 : -1;
+    e.original = false;
+    for (int k = 0; k < 3; ++k)
+      if (cv[i]->bary[k] == 0.0 && cv[j]->bary[k] == 0.0) e.original = true;
+  }
 
   // Planes over image pixels from the unsnapped positions: depth and
   // barycentrics then stay those of the true triangle (what a ray caster
@@ -140,107 +149,152 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
     b2[i] = cv[i]->bary.z / p.w;
   }
   t->depth = makePlane(x, y, z, areaPixels);
-  t->invW = makePlane(x, y, invW, areaPixels);
-  t->dOverW = makePlane(x, y, dOverW, areaPixels);
-  t->b1OverW = makePlane(x, y, b1, areaPixels);
-  t->b2OverW = makePlane(x, y, b2, areaPixels);
-  t->maxDepthSlope = std::max(std::abs(t->depth.dx), std::abs(t->depth.dy));
-  const double offset = polygonOffset(ds.format, ds.offsetFactor, ds.offsetUnits, t->maxDepthSlope,
+  t->invW = makeCoefficients(x, y, invW, areaPixels);
+  t->dOverW = makeCoefficients(x, y, dOverW, areaPixels);
+  t->b1OverW = makeCoefficients(x, y, b1, areaPixels);
+  t->b2OverW = makeCoefficients(x, y, b2, areaPixels);
+  const double offset = polygonOffset(ds.format, ds.offsetFactor, ds.offsetUnits, t->maxDepthSlope(),
                                       std::max({z[0], z[1], z[2]}));
   // Positive offsets push away from the viewer: towards 1 conventionally, 0 reversed.
   t->depth.v0 += isReversed(ds.format) ? -offset : offset;
-  return (t->pixelMin.x > t->pixelMax.x || t->pixelMin.y > t->pixelMax.y) ? SetupOutcome::Offscreen
-                                                                          : SetupOutcome::Ok;
+  return SetupOutcome::Ok;
 }
+
+namespace {
+
+// A run of one instance's triangles, set up together.
+struct SetupChunk {
+  uint32_t instance, first, count;
+};
+
+// What one chunk produced, handed from the parallel stage to the ordered one.
+struct ChunkOutput {
+  uint32_t inputs = 0;  // the chunk's triangles
+  std::vector<TriangleSetup> setups;
+  SetupCounters counters;
+};
+
+void add(const SetupCounters& from, SetupCounters* to) {
+  to->trianglesIn += from.trianglesIn;
+  to->degenerate += from.degenerate;
+  to->culled += from.culled;
+  to->outside += from.outside;
+  to->clipped += from.clipped;
+  to->fromClipping += from.fromClipping;
+  to->guardBandClipped += from.guardBandClipped;
+}
+
+// Transform, clip and set up one chunk's triangles in order.
+void setupChunk(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
+                const DepthSettings& depth, CullMode cull, const TriangleFilter& filter,
+                const SetupChunk& chunk, ChunkOutput* out) {
+  const Instance& inst = scene.instances[chunk.instance];
+  const CullMode instanceCull = scene.materials[inst.material].doubleSided ? CullMode::None : cull;
+  SetupCounters& n = out->counters;
+  out->setups.reserve(chunk.count);  // one piece per triangle unless clipping splits it
+  for (uint32_t k = chunk.first; k < chunk.first + chunk.count; ++k) {
+    if (filter.candidates && !((*filter.candidates)[inst.firstTriangle + k] & filter.candidateBit)) continue;
+    ++n.trianglesIn;
+    const glm::uvec3 idx = scene.triangles[inst.firstTriangle + k];
+    const glm::dvec3 p[3] = {glm::dvec3(scene.positions[idx.x]), glm::dvec3(scene.positions[idx.y]),
+                             glm::dvec3(scene.positions[idx.z])};
+    if (isDegenerate(scene, inst.firstTriangle + k)) {
+      ++n.degenerate;  // SPEC §1: zero world area covers nothing
+      continue;
+    }
+    glm::dvec4 clip[3];
+    for (int i = 0; i < 3; ++i)
+      clip[i] =
+          space.project(glm::dvec3(space.viewFromWorld * glm::dvec4(p[i], 1.0)), glm::dvec3(0.0)).position;
+    const ClipResult cr = clipTriangle(space, clip);
+    if (cr.outcome == ClipOutcome::Outside) {
+      ++n.outside;
+      continue;
+    }
+    if (cr.outcome == ClipOutcome::Clipped) {
+      ++n.clipped;
+      if (cr.guardClipped) ++n.guardBandClipped;
+      n.fromClipping += uint64_t(cr.count - 2);
+    }
+    TriangleSetup t;
+    t.instance = chunk.instance;
+    t.triangle = k;
+    t.fromClipping = cr.outcome == ClipOutcome::Clipped;
+    t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
+    bool culled = false, visible = false, degenerate = false;
+    for (int i = 1; i + 1 < cr.count; ++i) {
+      const ClipVertex fan[3] = {cr.vertices[0], cr.vertices[i], cr.vertices[i + 1]};
+      const SetupOutcome o = setupTriangle(space, grid, depth, fan, instanceCull, &t);
+      if (o == SetupOutcome::Culled) culled = true;
+      if (o == SetupOutcome::Degenerate) degenerate = true;
+      if (o != SetupOutcome::Ok) continue;
+      visible = true;
+      out->setups.push_back(t);
+    }
+    if (!visible) {
+      if (culled)
+        ++n.culled;
+      else if (degenerate && cr.count == 3)
+        ++n.degenerate;  // zero area after snapping: sub-pixel sliver or edge-on
+      else
+        ++n.outside;
+    }
+  }
+}
+
+}  // namespace
 
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
                                             const SampleGrid& grid, const DepthSettings& depth, CullMode cull,
                                             TriangleFilter filter, SetupCounters* counters) {
-  // Work in chunks of one instance's triangles, each with its own output,
-  // concatenated in chunk order: deterministic whatever the scheduling.
-  struct Chunk {
-    uint32_t instance, first, count;
-    std::vector<TriangleSetup> out;
-    SetupCounters counters;
-  };
+  // Chunks of one instance's triangles, set up in parallel and appended in
+  // chunk order by a pipeline: deterministic whatever the scheduling, and
+  // only the chunks in flight (a few per thread) exist besides the result,
+  // so the frame never holds two copies of its setups.
   constexpr uint32_t kChunk = 2048;
-  std::vector<Chunk> chunks;
+  std::vector<SetupChunk> chunks;
+  size_t inputs = 0;
   for (uint32_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& inst = scene.instances[i];
     const AlphaMode mode = scene.materials[inst.material].alphaMode;
     if (mode == AlphaMode::Blend ? !filter.blend : !filter.opaque) continue;
     for (uint32_t f = 0; f < inst.triangleCount; f += kChunk)
-      chunks.push_back({i, f, std::min(kChunk, inst.triangleCount - f), {}, {}});
+      chunks.push_back({i, f, std::min(kChunk, inst.triangleCount - f)});
+    inputs += inst.triangleCount;
   }
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t c = r.begin(); c != r.end(); ++c) {
-          Chunk& chunk = chunks[c];
-          const Instance& inst = scene.instances[chunk.instance];
-          const CullMode instanceCull = scene.materials[inst.material].doubleSided ? CullMode::None : cull;
-          SetupCounters& n = chunk.counters;
-          for (uint32_t k = chunk.first; k < chunk.first + chunk.count; ++k) {
-            ++n.trianglesIn;
-            const glm::uvec3 idx = scene.triangles[inst.firstTriangle + k];
-            const glm::dvec3 p[3] = {glm::dvec3(scene.positions[idx.x]), glm::dvec3(scene.positions[idx.y]),
-                                     glm::dvec3(scene.positions[idx.z])};
-            if (isDegenerate(scene, inst.firstTriangle + k)) {
-              ++n.degenerate;  // SPEC §1: zero world area covers nothing
-              continue;
-            }
-            glm::dvec4 clip[3];
-            for (int i = 0; i < 3; ++i)
-              clip[i] =
-                  space.project(glm::dvec3(space.viewFromWorld * glm::dvec4(p[i], 1.0)), glm::dvec3(0.0))
-                      .position;
-            const ClipResult cr = clipTriangle(space, clip);
-            if (cr.outcome == ClipOutcome::Outside) {
-              ++n.outside;
-              continue;
-            }
-            if (cr.outcome == ClipOutcome::Clipped) {
-              ++n.clipped;
-              if (cr.guardClipped) ++n.guardBandClipped;
-              n.fromClipping += uint64_t(cr.count - 2);
-            }
-            TriangleSetup t;
-            t.instance = chunk.instance;
-            t.triangle = k;
-            t.parent = inst.firstTriangle + k;
-            t.fromClipping = cr.outcome == ClipOutcome::Clipped;
-            t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
-            bool culled = false, visible = false, degenerate = false;
-            for (int i = 1; i + 1 < cr.count; ++i) {
-              const ClipVertex fan[3] = {cr.vertices[0], cr.vertices[i], cr.vertices[i + 1]};
-              const SetupOutcome o = setupTriangle(space, grid, depth, fan, instanceCull, &t);
-              if (o == SetupOutcome::Culled) culled = true;
-              if (o == SetupOutcome::Degenerate) degenerate = true;
-              if (o != SetupOutcome::Ok) continue;
-              visible = true;
-              chunk.out.push_back(t);
-            }
-            if (!visible) {
-              if (culled)
-                ++n.culled;
-              else if (degenerate && cr.count == 3)
-                ++n.degenerate;  // zero area after snapping: sub-pixel sliver or edge-on
-              else
-                ++n.outside;
-            }
-          }
-        }
-      });
+  // One setup per input triangle at most, unless clipping splits some: the
+  // capacity is reserved once, and pages the setups never reach are never
+  // touched (so they cost address space, not memory).
   std::vector<TriangleSetup> setups;
-  for (Chunk& c : chunks) {
-    setups.insert(setups.end(), c.out.begin(), c.out.end());
-    counters->trianglesIn += c.counters.trianglesIn;
-    counters->degenerate += c.counters.degenerate;
-    counters->culled += c.counters.culled;
-    counters->outside += c.counters.outside;
-    counters->clipped += c.counters.clipped;
-    counters->fromClipping += c.counters.fromClipping;
-    counters->guardBandClipped += c.counters.guardBandClipped;
-  }
+  setups.reserve(inputs);
+  size_t next = 0, appendedInputs = 0;
+  const size_t tokens = 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+  tbb::parallel_pipeline(
+      tokens, tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order,
+                                             [&](tbb::flow_control& fc) -> size_t {
+                                               if (next == chunks.size()) fc.stop();
+                                               return next++;
+                                             }) &
+                  tbb::make_filter<size_t, std::shared_ptr<ChunkOutput>>(
+                      tbb::filter_mode::parallel,
+                      [&](size_t c) {
+                        auto out = std::make_shared<ChunkOutput>();
+                        if (c >= chunks.size()) return out;
+                        out->inputs = chunks[c].count;
+                        setupChunk(scene, space, grid, depth, cull, filter, chunks[c], out.get());
+                        return out;
+                      }) &
+                  tbb::make_filter<std::shared_ptr<ChunkOutput>, void>(
+                      tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<ChunkOutput>& out) {
+                        appendedInputs += out->inputs;
+                        // Clipping made more pieces than the reserve foresaw: grow
+                        // once by what the remaining inputs can still need.
+                        if (setups.size() + out->setups.size() > setups.capacity())
+                          setups.reserve(setups.size() + out->setups.size() +
+                                         (inputs - std::min(inputs, appendedInputs)));
+                        setups.insert(setups.end(), out->setups.begin(), out->setups.end());
+                        add(out->counters, counters);
+                      }));
   return setups;
 }
 

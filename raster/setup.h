@@ -32,6 +32,8 @@
 // area before the reordering: CCW with y up is clockwise with y down.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
@@ -68,34 +70,52 @@ struct Plane {
   double at(double x, double y) const { return v0 + dx * (x - x0) + dy * (y - y0); }
 };
 
-struct EdgeFunction {
-  int64_t a = 0, b = 0, c = 0;  // E(p) = a·px + b·py + c, p in units
-  int64_t bias = 0;             // 0 for top-left edges, −1 else
-  bool topLeft = false;
-  bool original = false;  // lies on an edge of the original (unclipped) triangle
-  int64_t at(int64_t px, int64_t py) const { return a * px + b * py + c; }
+// A plane's coefficients without its origin: the planes of one setup all
+// pass through the same vertex, so they share the origin stored once (in
+// TriangleSetup::depth) and evaluate with the same arithmetic as Plane::at.
+struct PlaneCoefficients {
+  double v0 = 0.0, dx = 0.0, dy = 0.0;
+  double at(double x, double y, double x0, double y0) const { return v0 + dx * (x - x0) + dy * (y - y0); }
 };
 
+// Range proof for the narrow types: a and b are differences of two clamped
+// coordinates, |a|, |b| <= 2^30 < 2^31 (int32); c <= 2^60 needs int64. at()
+// widens before multiplying, so every product is an exact int64.
+struct EdgeFunction {
+  int32_t a = 0, b = 0;  // E(p) = a·px + b·py + c, p in units
+  int64_t c = 0;
+  int8_t bias = 0;  // 0 for top-left edges, −1 else
+  bool topLeft = false;
+  bool original = false;  // lies on an edge of the original (unclipped) triangle
+  int64_t at(int64_t px, int64_t py) const { return int64_t(a) * px + int64_t(b) * py + c; }
+};
+
+// One set-up triangle (or clipped piece): 272 bytes. What is not kept
+// because it can be derived: the clip vertices' barycentrics (only
+// `original` needs them), the parent's stored index (the instance's first
+// triangle + `triangle`), the maximum depth slope (from the depth plane),
+// and the interpolation planes' shared origin.
 struct TriangleSetup {
   uint32_t instance = 0, triangle = 0;
-  uint32_t parent = 0;                   // index of the source triangle in the scene store
-  glm::i64vec2 vertex[3];                // snapped, units
-  glm::dvec3 bary[3];                    // weights of the original stored vertices, in setup order
+  glm::ivec2 vertex[3];                  // snapped, units; |X|, |Y| <= 2^29 fit int32
   EdgeFunction edge[3];                  // edge i runs vertex i → vertex (i+1) % 3
   glm::ivec2 pixelMin{0}, pixelMax{-1};  // inclusive pixel bounds, clipped to the image
   Plane depth;                           // window depth z (format space, polygon offset applied)
-  Plane invW, dOverW, b1OverW, b2OverW;
-  double maxDepthSlope = 0.0;  // max(|∂z/∂x|, |∂z/∂y|) before offset
+  // 1/w, d/w, b1/w, b2/w, all through depth's origin (depth.x0, depth.y0).
+  PlaneCoefficients invW, dOverW, b1OverW, b2OverW;
+  double centroidDepth = 0.0;  // view depth of the ORIGINAL triangle's centroid (sorted mode)
   bool frontFacing = true;
   bool fromClipping = false;
-  double centroidDepth = 0.0;  // view depth of the ORIGINAL triangle's centroid (sorted mode)
 
   uint64_t id() const { return (uint64_t(instance) << 32) | triangle; }
+  // max(|∂z/∂x|, |∂z/∂y|) before offset (the offset moves only depth.v0).
+  double maxDepthSlope() const { return std::max(std::abs(depth.dx), std::abs(depth.dy)); }
   // Perspective-correct values at an image position.
-  double viewDepthAt(double x, double y) const { return dOverW.at(x, y) / invW.at(x, y); }
+  double invWAt(double x, double y) const { return invW.at(x, y, depth.x0, depth.y0); }
+  double viewDepthAt(double x, double y) const { return dOverW.at(x, y, depth.x0, depth.y0) / invWAt(x, y); }
   glm::dvec2 baryAt(double x, double y) const {
-    const double inv = 1.0 / invW.at(x, y);
-    return {b1OverW.at(x, y) * inv, b2OverW.at(x, y) * inv};
+    const double inv = 1.0 / invWAt(x, y);
+    return {b1OverW.at(x, y, depth.x0, depth.y0) * inv, b2OverW.at(x, y, depth.x0, depth.y0) * inv};
   }
 };
 
@@ -123,16 +143,21 @@ struct SetupCounters {
   uint64_t guardBandClipped = 0;  // of the clipped, those beyond the guard band
 };
 
-// Which material classes to set up (Opaque covers OPAQUE and MASK).
+// Which triangles to set up: by material class (Opaque covers OPAQUE and
+// MASK) and, with `candidates` (one byte per stored triangle), only those
+// whose byte has a bit of `candidateBit` set (a cube-map face's share).
 struct TriangleFilter {
   bool opaque = true;
   bool blend = true;
+  const std::vector<uint8_t>* candidates = nullptr;
+  uint8_t candidateBit = 0;
 };
 
 // Transform (world → view in double), clip and set up every triangle of the
 // scene that passes `filter`, in scene order (instance, triangle; clipped
 // pieces in fan order), independently of the thread count. `cull` applies
-// to single-sided materials only.
+// to single-sided materials only. Memory: the result (reserved once for
+// one setup per input triangle) and a few chunks in flight per thread.
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
                                             const SampleGrid& grid, const DepthSettings& depth, CullMode cull,
                                             TriangleFilter filter, SetupCounters* counters);

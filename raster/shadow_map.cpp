@@ -1,5 +1,6 @@
 #include "raster/shadow_map.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -28,7 +29,71 @@ Camera lightCamera(const glm::dvec3& eye, const glm::dvec3& forward, int size) {
   return c;
 }
 
+// Perspective map cameras at `eye` along `forward` with full angle `yfov`.
+Camera perspectiveLightCamera(const glm::dvec3& eye, const glm::dvec3& forward, double yfov, double znear,
+                              int size) {
+  Camera c = lightCamera(eye, forward, size);
+  c.projection = Projection::Perspective;
+  c.yfov = yfov;
+  c.znear = znear;
+  c.zfar = std::numeric_limits<double>::infinity();
+  return c;
+}
+
+// The cube faces' axes, in face order.
+const glm::dvec3 kCubeAxes[kCubeFaces] = {glm::dvec3(1, 0, 0),  glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0),
+                                          glm::dvec3(0, -1, 0), glm::dvec3(0, 0, 1),  glm::dvec3(0, 0, -1)};
+
 }  // namespace
+
+std::vector<Camera> cubeFaceCameras(const glm::dvec3& eye, int size, double znear) {
+  std::vector<Camera> faces;
+  // A hair over 90° so that the faces overlap at their seams.
+  for (const glm::dvec3& d : kCubeAxes)
+    faces.push_back(perspectiveLightCamera(eye, d, kPi / 2.0 + 2.0 / size, znear, size));
+  return faces;
+}
+
+// A face's frustum is |u|, |v| <= t·depth around its axis
+// (t = tan(fov/2), the face's NDC scale). A bit stays clear only when all
+// three vertices lie beyond one side plane with t widened by 4/size (two
+// texels) plus a rounding margin of 1e-9 of the vertices' extent: clipping
+// keeps the polygon in that half-space, so every piece lies more than a
+// texel outside the face and setup would find it off the image. So the
+// faces set up only their own triangles (about a sixth of the scene each
+// instead of all of it) and the maps come out bit-identical.
+std::vector<uint8_t> cubeFaceCandidates(const Scene& scene, const glm::dvec3& eye, double t, int size) {
+  std::vector<uint8_t> mask(scene.triangles.size(), 0);
+  const double wide = t * (1.0 + 4.0 / double(size));
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, mask.size()), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const glm::uvec3 idx = scene.triangles[i];
+      const glm::dvec3 d[3] = {glm::dvec3(scene.positions[idx.x]) - eye,
+                               glm::dvec3(scene.positions[idx.y]) - eye,
+                               glm::dvec3(scene.positions[idx.z]) - eye};
+      double extent = 0.0;
+      for (const glm::dvec3& v : d) extent = std::max(extent, std::abs(v.x) + std::abs(v.y) + std::abs(v.z));
+      const double margin = 1e-9 * extent * (1.0 + wide);
+      uint8_t bits = 0;
+      for (int f = 0; f < kCubeFaces; ++f) {
+        const int k = f / 2;
+        const double sign = (f % 2 == 0) ? 1.0 : -1.0;
+        bool reached = true;
+        for (int side = 0; side < 4 && reached; ++side) {
+          const int axis = (k + 1 + side / 2) % 3;
+          const double s = (side % 2 == 0) ? 1.0 : -1.0;
+          // Plane value wide·depth − s·u at each vertex; all below −margin: missed.
+          bool missed = true;
+          for (const glm::dvec3& v : d) missed = missed && wide * (sign * v[k]) - s * v[axis] < -margin;
+          reached = !missed;
+        }
+        if (reached) bits |= uint8_t(1u << f);
+      }
+      mask[i] = bits;
+    }
+  });
+  return mask;
+}
 
 ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const Shader* shader)
     : scene_(scene) {
@@ -53,31 +118,26 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
     } else {
       // Near plane: small against the scene, far: infinite.
       const double znear = std::max(1e-6, 1e-4 * radius);
-      std::vector<std::pair<glm::dvec3, double>> views;  // direction, yfov
       if (light.type == LightType::Spot)
-        views.push_back({light.direction, std::min(2.0 * double(light.outerConeAngle) + 0.01, kPi * 0.95)});
+        cameras.push_back(perspectiveLightCamera(
+            light.position, light.direction, std::min(2.0 * double(light.outerConeAngle) + 0.01, kPi * 0.95),
+            znear, size));
       else
-        for (const glm::dvec3& d : {glm::dvec3(1, 0, 0), glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0),
-                                    glm::dvec3(0, -1, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, 0, -1)})
-          // A hair over 90° so that the faces overlap at their seams.
-          views.push_back({d, kPi / 2.0 + 2.0 / size});
-      for (const auto& [dir, fov] : views) {
-        Camera c = lightCamera(light.position, dir, size);
-        c.projection = Projection::Perspective;
-        c.yfov = fov;
-        c.znear = znear;
-        c.zfar = std::numeric_limits<double>::infinity();
-        cameras.push_back(c);
-      }
+        cameras = cubeFaceCameras(light.position, size, znear);
     }
-    for (const Camera& c : cameras) {
+    const bool cube = cameras.size() == kCubeFaces;
+    std::vector<uint8_t> faces;
+    for (size_t f = 0; f < cameras.size(); ++f) {
+      const Camera& c = cameras[f];
       const SampleGrid grid = makeSampleGrid(1, size, size);
       Map map{c, makeClipSpace(c, grid.guardPixels), DepthTarget(size, size, 1, true)};
+      if (cube && faces.empty()) faces = cubeFaceCandidates(scene, light.position, map.space.scale.x, size);
       DepthSettings ds{
           kMapFormat, c.projection, c.znear, c.zfar, options.shadowBiasSlope, options.shadowBiasConstant};
       SetupCounters counters;
+      const TriangleFilter filter{true, true, cube ? &faces : nullptr, uint8_t(cube ? 1u << f : 0u)};
       const std::vector<TriangleSetup> setups =
-          prepareTriangles(scene, map.space, grid, ds, options.cull, {true, true}, &counters);
+          prepareTriangles(scene, map.space, grid, ds, options.cull, filter, &counters);
       triangles_ += counters.trianglesIn;
       const TileGrid tiles(size, size);
       // BLEND and refractive surfaces attenuate instead of blocking (with a
@@ -86,8 +146,9 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         const Material& m = scene.materialOf(t.instance);
         return shader && (m.alphaMode == AlphaMode::Blend || m.isRefractive());
       };
-      const auto bins = binTriangles(tiles, setups, [&](const TriangleSetup& t) { return !transmissive(t); });
-      const auto transmissiveBins = binTriangles(tiles, setups, transmissive);
+      const auto bins =
+          binTriangles(tiles, grid, setups, [&](const TriangleSetup& t) { return !transmissive(t); });
+      const auto transmissiveBins = binTriangles(tiles, grid, setups, transmissive);
       const auto surfaceAt = [&](const TriangleSetup& t, int px, int py, int s) {
         const glm::dvec2 pos = glm::dvec2(px, py) + grid.positions[size_t(s)];
         const glm::dvec2 b = t.baryAt(pos.x, pos.y);

@@ -19,6 +19,7 @@
 // they block like opaque surfaces.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "common/analysis.h"
@@ -29,6 +30,17 @@
 #include "raster/options.h"
 
 namespace rastray {
+
+// A point light's cube map: six faces, ±X, ±Y, ±Z in this order.
+constexpr int kCubeFaces = 6;
+std::vector<Camera> cubeFaceCameras(const glm::dvec3& eye, int size, double znear);
+
+// Which faces of the cube map at `eye` each stored triangle can reach: bit f
+// of byte i for face f of triangle i, from the faces' NDC scale `t`
+// (ClipSpace::scale) and size in texels. Conservative: a face whose bit is
+// clear would set up nothing of the triangle, so each face sets up only its
+// candidates and the maps stay identical.
+std::vector<uint8_t> cubeFaceCandidates(const Scene& scene, const glm::dvec3& eye, double t, int size);
 
 class ShadowMaps : public LightVisibility {
  public:

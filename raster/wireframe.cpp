@@ -63,7 +63,7 @@ uint64_t drawWireframe(const std::vector<TriangleSetup>& setups, const SampleGri
     double maxZ = 0.0;
     for (int i = 0; i < 3; ++i)
       maxZ = std::max(maxZ, t.depth.at(double(t.vertex[i].x) / U, double(t.vertex[i].y) / U));
-    return polygonOffset(format, std::abs(style.offsetFactor), std::abs(style.offsetUnits), t.maxDepthSlope,
+    return polygonOffset(format, std::abs(style.offsetFactor), std::abs(style.offsetUnits), t.maxDepthSlope(),
                          std::min(1.0, maxZ));
   };
   // The surface's nearness at a pixel's first sample; nothing there: −inf.

@@ -161,7 +161,7 @@ TEST(PolygonOffset, UnitsAndFactorMoveCoplanarSurfaces) {
         const double maxZ = std::max({z, base.setups[i].depth.at(0, 0), base.setups[i].depth.at(32, 32)});
         (void)maxZ;
         EXPECT_GT(away * units, 0.0) << toString(format);
-        EXPECT_NEAR(std::abs(isReversed(format) ? z - zs : zs - z), base.setups[i].maxDepthSlope, 1e-15);
+        EXPECT_NEAR(std::abs(isReversed(format) ? z - zs : zs - z), base.setups[i].maxDepthSlope(), 1e-15);
       }
       // Rasterized against the un-offset copy: offset −1 unit wins every sample, +1 none.
       std::vector<TriangleSetup> both = base.setups;
