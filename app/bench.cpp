@@ -1,6 +1,7 @@
 #include "app/bench.h"
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -15,6 +16,12 @@ namespace {
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double processCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 uint64_t peakRssBytes() {
@@ -71,10 +78,13 @@ BenchResult runBench(const BenchRequest& request) {
   const int count = request.warmup + request.frames;
   for (int i = 0; i < count; ++i) {
     const auto start = std::chrono::steady_clock::now();
+    const double cpuStart = processCpuSeconds();
     RenderOutput output = renderer.frame();
     const double seconds = secondsSince(start);
+    const double cpuSeconds = processCpuSeconds() - cpuStart;
     if (i >= request.warmup) {
       r.frameSeconds.push_back(seconds);
+      r.cpuSeconds.push_back(cpuSeconds);
       for (const auto& [name, value] : output.timings) {
         if (!stageSeconds.count(name)) stageOrder.push_back(name);
         stageSeconds[name].push_back(value);
@@ -88,6 +98,7 @@ BenchResult runBench(const BenchRequest& request) {
     if (request.progress) request.progress(i + 1, count);
   }
   r.frame = spreadOf(r.frameSeconds);
+  r.cpu = spreadOf(r.cpuSeconds);
   for (const std::string& name : stageOrder) r.stages.push_back({name, spreadOf(stageSeconds[name])});
   r.peakRssBytes = peakRssBytes();
   return r;
@@ -112,6 +123,8 @@ nlohmann::json benchJson(const BenchResult& r) {
   j["bvhBuildSeconds"] = r.bvhBuildSeconds >= 0.0 ? nlohmann::json(r.bvhBuildSeconds) : nlohmann::json();
   j["frameSeconds"] = r.frameSeconds;
   j["frame"] = spreadJson(r.frame);
+  j["cpuSeconds"] = r.cpuSeconds;
+  j["cpu"] = spreadJson(r.cpu);
   nlohmann::json stages = nlohmann::json::object();
   for (const StageTime& st : r.stages) stages[st.name] = spreadJson(st.seconds);
   j["stages"] = stages;
@@ -167,6 +180,8 @@ std::string benchText(const BenchResult& r) {
     add("%-34s %10.3f %10.3f %10.3f\n", st.name.c_str(), st.seconds.median * 1e3, st.seconds.min * 1e3,
         st.seconds.max * 1e3);
   add("%-34s %10.3f %10.3f %10.3f\n", "frame", r.frame.median * 1e3, r.frame.min * 1e3, r.frame.max * 1e3);
+  add("%-34s %10.3f %10.3f %10.3f\n", "frame, CPU time of all threads", r.cpu.median * 1e3, r.cpu.min * 1e3,
+      r.cpu.max * 1e3);
 
   add("\n%-34s %16s\n", "counter (one frame)", "value");
   for (const auto& [name, value] : r.counters.values)

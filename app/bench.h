@@ -48,6 +48,11 @@ struct BenchResult {
   double bvhBuildSeconds = -1.0;     // negative without a ray caster
   std::vector<double> frameSeconds;  // the timed frames, in order
   Spread frame;
+  // CPU time of all this process's threads per timed frame: less sensitive
+  // than wall time to other work on a shared machine (it still counts
+  // cache and memory contention).
+  std::vector<double> cpuSeconds;
+  Spread cpu;
   std::vector<StageTime> stages;  // per-stage times over the timed frames
   CounterSet counters;            // of the last frame (every frame does the same work)
   std::vector<std::string> passesRun, passesLeftOut;

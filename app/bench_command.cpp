@@ -1,5 +1,5 @@
 // `rastray bench SCENE --renderer raster|raytrace|hybrid --size W H --spp N
-// --frames K [render and camera options]`
+// --frames K [render and camera options] [--peers]`
 #include <unistd.h>
 
 #include <cmath>
@@ -12,6 +12,7 @@
 #include <tbb/global_control.h>
 
 #include "app/bench.h"
+#include "app/bench_peers.h"
 #include "app/commands.h"
 #include "app/sweep_crossover_scene.h"
 #include "common/error.h"
@@ -27,6 +28,9 @@ struct BenchCommandOptions {
   std::string workDir = "bench-work";
   std::string jsonPath;
   std::string csvPath;
+  bool peers = false;
+  int rounds = 3;
+  std::string peersCsvPath;
   RenderSettings settings;
 };
 
@@ -61,6 +65,134 @@ std::string resolveScene(const BenchCommandOptions& opt) {
   return path;
 }
 
+// Our frames and one peer's, gathered over every round.
+struct PeerRow {
+  PeerRun run;  // the first round's, with every round's frames appended
+  Spread wall, cpu;
+};
+
+// Rounds alternate ours and the peer, so load on a shared machine hits both
+// alike; ours stays prepared (scene, BVH) across rounds. The rasterizer and
+// hybrid run beside llvmpipe, the ray caster beside Embree's viewer.
+std::vector<PeerRow> runPeerRounds(const BenchCommandOptions& opt, const BenchRequest& request,
+                                   const BenchResult& first, std::vector<double>* ourWall,
+                                   std::vector<double>* ourCpu, bool terminal) {
+  PeerRequest pr;
+  pr.scenePath = request.scenePath;
+  pr.camera = makeCamera(loadSceneForRender(request.scenePath, request.settings),
+                         request.settings.camera.overrides(), first.width, first.height);
+  pr.spp = first.spp;
+  pr.threads = first.threads;
+  pr.frames = opt.frames;
+  pr.workDir = opt.workDir + "/peers";
+  std::vector<PeerRow> rows;
+  for (int round = 0; round < opt.rounds; ++round) {
+    if (round > 0) {
+      BenchRequest again = request;
+      again.warmup = 0;
+      again.progress = nullptr;
+      const BenchResult more = runBench(again);
+      ourWall->insert(ourWall->end(), more.frameSeconds.begin(), more.frameSeconds.end());
+      ourCpu->insert(ourCpu->end(), more.cpuSeconds.begin(), more.cpuSeconds.end());
+    }
+    if (terminal) std::fprintf(stderr, "\rbench: peers, round %d/%d", round + 1, opt.rounds);
+    PeerRun run = first.renderer == RendererKind::Raytrace ? runEmbreeViewer(pr) : runOsmesaPeer(pr);
+    if (rows.empty()) {
+      rows.push_back({run, {}, {}});
+    } else {
+      PeerRun& all = rows.front().run;
+      all.frameMs.insert(all.frameMs.end(), run.frameMs.begin(), run.frameMs.end());
+      all.cpuMs.insert(all.cpuMs.end(), run.cpuMs.begin(), run.cpuMs.end());
+      if (!run.ran && all.ran) all.error = run.error.empty() ? run.skipped : run.error;
+    }
+    if (!run.ran) break;  // absent or failing: once is enough
+  }
+  if (terminal) std::fputs("\r\033[K", stderr);
+  for (PeerRow& row : rows) {
+    std::vector<double> wall, cpu;
+    for (double ms : row.run.frameMs) wall.push_back(ms / 1e3);
+    for (double ms : row.run.cpuMs) cpu.push_back(ms / 1e3);
+    row.wall = spreadOf(wall);
+    row.cpu = spreadOf(cpu);
+  }
+  return rows;
+}
+
+void printPeerTable(const BenchResult& ours, const Spread& wall, const Spread& cpu,
+                    const std::vector<PeerRow>& rows, int rounds, int frames) {
+  std::printf(
+      "\npeers: %d rounds of %d frames, alternating with ours; ratio = peer / rastray (above 1: rastray "
+      "is faster)\n",
+      rounds, frames);
+  std::printf("%-40s %10s %10s %10s %10s %8s %8s\n", "renderer", "median ms", "min ms", "max ms", "cpu ms",
+              "ratio", "cpu ratio");
+  const std::string name = std::string("rastray ") + toString(ours.renderer);
+  std::printf("%-40s %10.3f %10.3f %10.3f %10.3f %8s %8s\n", name.c_str(), wall.median * 1e3, wall.min * 1e3,
+              wall.max * 1e3, cpu.median * 1e3, "1.00", "1.00");
+  for (const PeerRow& row : rows) {
+    const PeerRun& p = row.run;
+    if (!p.ran) {
+      std::printf("%-40s %s: %s\n", p.peer.c_str(), p.skipped.empty() ? "failed" : "skipped",
+                  p.skipped.empty() ? p.error.c_str() : p.skipped.c_str());
+      continue;
+    }
+    char cpuText[32] = "-", cpuRatio[32] = "-";
+    if (row.cpu.count > 0) {
+      std::snprintf(cpuText, sizeof cpuText, "%.3f", row.cpu.median * 1e3);
+      std::snprintf(cpuRatio, sizeof cpuRatio, "%.2f", row.cpu.median / cpu.median);
+    }
+    std::printf("%-40s %10.3f %10.3f %10.3f %10s %8.2f %8s\n", p.peer.c_str(), row.wall.median * 1e3,
+                row.wall.min * 1e3, row.wall.max * 1e3, cpuText, row.wall.median / wall.median, cpuRatio);
+    if (ours.renderer == RendererKind::Raytrace && ours.spp == 1) {
+      const double rays = double(ours.width) * double(ours.height);
+      std::printf("  primary rays: rastray %.2f Mrays/s, %s %.2f Mrays/s (one ray per pixel, eye light)\n",
+                  rays / wall.median / 1e6, p.peer.c_str(), rays / row.wall.median / 1e6);
+    }
+    if (!p.renderer.empty()) std::printf("  %s: %s\n", p.peer.c_str(), p.renderer.c_str());
+    if (!p.error.empty()) std::printf("  note: a later round failed: %s\n", p.error.c_str());
+  }
+}
+
+// Work of ours that the peers leave out (they draw one eye-lit, unshadowed
+// surface per pixel): the comparison is fair only without it.
+std::vector<std::string> workPeersLeaveOut(const BenchResult& ours) {
+  std::vector<std::string> extra;
+  const auto count = [&](const char* name) { return ours.counters.get(name); };
+  if (count("raster.shadow_maps") > 0)
+    extra.push_back(std::to_string(count("raster.shadow_maps")) + " shadow maps");
+  for (const char* kind : {"rays.shadow", "rays.reflection", "rays.refraction", "rays.transparency"})
+    if (count(kind) > 0) extra.push_back(std::to_string(count(kind)) + " " + kind);
+  if (count("raster.fragments_transparent") > 0) extra.push_back("a transparency pass");
+  return extra;
+}
+
+void appendPeersCsv(const std::string& path, const BenchResult& ours, const Spread& wall, const Spread& cpu,
+                    const std::vector<PeerRow>& rows) {
+  const bool fresh = !std::filesystem::exists(path) || std::filesystem::file_size(path) == 0;
+  std::ofstream f(path, std::ios::app);
+  if (fresh)
+    f << "scene,renderer,width,height,spp,threads,rastray_median_ms,rastray_cpu_ms,peer,peer_median_ms,"
+         "peer_min_ms,peer_max_ms,peer_cpu_ms,ratio,cpu_ratio\n";
+  std::string scene = ours.scenePath;
+  for (char& c : scene)
+    if (c == ',' || c == '"') c = '_';
+  for (const PeerRow& row : rows) {
+    if (!row.run.ran) continue;
+    char peerCpu[32] = "", cpuRatio[32] = "";  // empty: the peer reports no CPU time
+    if (row.cpu.count) {
+      std::snprintf(peerCpu, sizeof peerCpu, "%.3f", row.cpu.median * 1e3);
+      std::snprintf(cpuRatio, sizeof cpuRatio, "%.3f", row.cpu.median / cpu.median);
+    }
+    char line[768];
+    std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%d,%.3f,%.3f,%s,%.3f,%.3f,%.3f,%s,%.3f,%s\n",
+                  scene.c_str(), toString(ours.renderer), ours.width, ours.height, ours.spp, ours.threads,
+                  wall.median * 1e3, cpu.median * 1e3, row.run.peer.c_str(), row.wall.median * 1e3,
+                  row.wall.min * 1e3, row.wall.max * 1e3, peerCpu, row.wall.median / wall.median, cpuRatio);
+    f << line;
+  }
+  if (!f) throw InputError(path, "file", "cannot append");
+}
+
 int runBenchCommand(BenchCommandOptions& opt) {
   opt.settings.finish();
   if (opt.frames < 1) throw InputError("command line", "--frames", "must be at least 1");
@@ -78,7 +210,31 @@ int runBenchCommand(BenchCommandOptions& opt) {
 
   BenchResult result = runBench(request);
   if (terminal) std::fputs("\r\033[K", stderr);
-  std::fputs(benchText(result).c_str(), stdout);
+  std::vector<double> ourWall = result.frameSeconds, ourCpu = result.cpuSeconds;
+  std::vector<PeerRow> peers;
+  if (opt.peers) peers = runPeerRounds(opt, request, result, &ourWall, &ourCpu, terminal);
+  const Spread wall = spreadOf(ourWall), cpu = spreadOf(ourCpu);
+
+  const std::string text = benchText(result);
+  if (opt.peers) {
+    // The ratios go above the last line, which stays ours: the median of
+    // our frames over every round.
+    std::fputs(text.substr(0, text.rfind("\nmedian frame:") + 1).c_str(), stdout);
+    printPeerTable(result, wall, cpu, peers, opt.rounds, opt.frames);
+    const std::vector<std::string> extra = workPeersLeaveOut(result);
+    if (!extra.empty()) {
+      std::string list;
+      for (const std::string& e : extra) list += (list.empty() ? "" : ", ") + e;
+      std::printf(
+          "note: rastray's frame also does work the peers leave out (%s); for like-for-like frames use "
+          "--shadows none on a scene without mirrors, glass or BLEND\n",
+          list.c_str());
+    }
+    std::printf("\nmedian frame: %.3f ms\n", wall.median * 1e3);
+    if (!opt.peersCsvPath.empty()) appendPeersCsv(opt.peersCsvPath, result, wall, cpu, peers);
+  } else {
+    std::fputs(text.c_str(), stdout);
+  }
   if (!opt.csvPath.empty()) {
     const bool fresh = !std::filesystem::exists(opt.csvPath) || std::filesystem::file_size(opt.csvPath) == 0;
     std::ofstream f(opt.csvPath, std::ios::app);
@@ -87,7 +243,25 @@ int runBenchCommand(BenchCommandOptions& opt) {
     if (!f) throw InputError(opt.csvPath, "file", "cannot append");
   }
   if (!opt.jsonPath.empty()) {
-    const nlohmann::json j = benchJson(result);
+    nlohmann::json j = benchJson(result);
+    if (opt.peers) {
+      j["peerRounds"] = opt.rounds;
+      j["allRoundsFrameSeconds"] = ourWall;
+      nlohmann::json list = nlohmann::json::array();
+      for (const PeerRow& row : peers) {
+        const PeerRun& p = row.run;
+        list.push_back({{"peer", p.peer},
+                        {"ran", p.ran},
+                        {"skipped", p.skipped},
+                        {"error", p.error},
+                        {"command", p.command},
+                        {"renderer", p.renderer},
+                        {"frameMs", p.frameMs},
+                        {"cpuMs", p.cpuMs},
+                        {"ratio", p.ran && wall.median > 0 ? row.wall.median / wall.median : 0.0}});
+      }
+      j["peers"] = list;
+    }
     const std::string partial = opt.jsonPath + ".partial";
     {
       std::ofstream f(partial);
@@ -112,6 +286,15 @@ CommandRunner addBenchCommand(CLI::App& app) {
   cmd->add_option("--work-dir", opt->workDir,
                   "Where generated terrains and the peers' exported OBJ files go");
   cmd->add_option("--json", opt->jsonPath, "Also write the results as JSON (schema rastray.bench v1)");
+  CLI::Option* peers = cmd->add_flag(
+      "--peers", opt->peers,
+      "Run the peer in alternation with ours and print the ratios (raster, hybrid: Mesa llvmpipe "
+      "through OSMesa; raytrace: Embree's viewer)");
+  cmd->add_option("--rounds", opt->rounds, "With --peers: rounds of ours then the peer")
+      ->check(CLI::Range(1, 100))
+      ->needs(peers);
+  cmd->add_option("--peers-csv", opt->peersCsvPath, "With --peers: append one row per peer to this CSV file")
+      ->needs(peers);
   cmd->add_option("--csv", opt->csvPath, "Append one row to this CSV file (a header first when it is new)");
   addRenderSettings(*cmd, opt->settings);
   return [opt, cmd]() -> int { return cmd->parsed() ? runBenchCommand(*opt) : -1; };

@@ -3,6 +3,8 @@
 // command's last line and bad input.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <regex>
 
 #include "app/bench.h"
@@ -102,11 +104,42 @@ TEST(BenchCommand, GeneratedTerrainHasTheTrianglesAsked) {
   EXPECT_NE(r.out.find("2000 triangles"), std::string::npos) << r.out;
 }
 
+// The peers run in alternation with ours and their ratio is printed above
+// our median (a peer that is not built or installed is skipped with a
+// message; CI builds and installs both).
+TEST(BenchCommand, PeersPrintRatiosAndCsvRows) {
+  const std::string dir = testing::TempDir() + "/bench-peers";
+  const std::string csv = dir + "/peers.csv";
+  std::filesystem::remove_all(dir);
+  for (const char* renderer : {"raster", "raytrace"}) {
+    const test::CommandResult r =
+        test::runRastray({"bench", kCornell, "--renderer", renderer, "--size", "48", "32", "--frames", "2",
+                          "--peers", "--rounds", "2", "--work-dir", dir, "--peers-csv", csv});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("ratio = peer / rastray"), std::string::npos) << r.out;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("median frame: [0-9]+\\.[0-9]{3} ms\n$"))) << r.out;
+    const bool skipped = r.out.find("skipped:") != std::string::npos;
+    const char* peer = std::string(renderer) == "raster" ? "\nllvmpipe " : "\nembree viewer ";
+    if (!skipped) EXPECT_NE(r.out.find(peer), std::string::npos) << r.out;
+  }
+  std::ifstream f(csv);
+  std::string header, row;
+  std::getline(f, header);
+  EXPECT_EQ(header.rfind("scene,renderer,", 0), 0u);
+  int rows = 0;
+  while (std::getline(f, row)) {
+    ++rows;
+    EXPECT_EQ(std::count(row.begin(), row.end(), ','), std::count(header.begin(), header.end(), ',')) << row;
+  }
+  EXPECT_LE(rows, 2);
+}
+
 TEST(BenchCommand, BadInputExitsTwoWithOneLine) {
   for (const std::vector<std::string>& args :
        {std::vector<std::string>{"bench", "terrain:0", "--size", "8", "8"},
         std::vector<std::string>{"bench", "terrain:abc"},
         std::vector<std::string>{"bench", kCornell, "--frames", "0"},
+        std::vector<std::string>{"bench", kCornell, "--peers-csv", "x.csv"},  // needs --peers
         std::vector<std::string>{"bench", "/nonexistent/scene.gltf"}}) {
     const test::CommandResult r = test::runRastray(args);
     EXPECT_EQ(r.status, 2) << args[1];
