@@ -28,6 +28,11 @@ bool SceneAnalysis::needs(Work work) const {
   return false;
 }
 
+std::shared_ptr<const TextureSet> SceneAnalysis::textureSet(const Scene& scene) const {
+  if (!textures) return std::make_shared<const TextureSet>();
+  return sharedTextures ? sharedTextures->get(scene) : std::make_shared<const TextureSet>(scene);
+}
+
 namespace {
 
 // Materials (and the instances using them) that satisfy a predicate; only

@@ -4,10 +4,12 @@
 // work counters show zero for it.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "common/scene.h"
+#include "common/texture.h"
 
 namespace rastray {
 
@@ -37,6 +39,12 @@ struct SceneAnalysis {
   bool textures = false;
   bool eyeLight = false;                // no light in the scene: lit from the camera, no shadows
   std::vector<WorkDecision> decisions;  // one per Work, in enum order
+  std::shared_ptr<SharedTextureSet> sharedTextures = std::make_shared<SharedTextureSet>();
+
+  // The decoded textures and mip chains of `scene` (the analysed scene),
+  // built on the first call and shared by every copy of this analysis;
+  // empty when the scene needs no textures.
+  std::shared_ptr<const TextureSet> textureSet(const Scene& scene) const;
 
   bool secondaryRays() const { return reflection || refraction; }
   // Embree needs intersection/occlusion filters only for these.

@@ -32,7 +32,7 @@ Shader::Shader(const Scene& scene, const SceneAnalysis& analysis, const Camera& 
       options_(options),
       visibility_(visibility),
       secondary_(secondary),
-      textures_(std::make_shared<const TextureSet>(analysis.textures ? TextureSet(scene) : TextureSet())),
+      textures_(analysis.textureSet(scene)),
       eyeLight_(analysis.eyeLight) {}
 
 Shader::Shader(const Shader& shading, const LightVisibility* visibility, const SecondaryRayTracer* secondary)

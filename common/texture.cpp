@@ -159,4 +159,12 @@ glm::vec4 TextureSet::sample(int texture, glm::vec2 uv, const TextureFootprint& 
   return unpremultiply(t > 0.0f ? glm::mix(lookup(lo), lookup(lo + 1), t) : lookup(lo));
 }
 
+std::shared_ptr<const TextureSet> SharedTextureSet::get(const Scene& scene) const {
+  std::call_once(once_, [&] {
+    set_ = std::make_shared<const TextureSet>(scene);
+    scene_ = &scene;
+  });
+  return scene_ == &scene ? set_ : std::make_shared<const TextureSet>(scene);
+}
+
 }  // namespace rastray

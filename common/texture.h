@@ -16,6 +16,8 @@
 // of level 0, lambda = log2(rho); lambda <= 0 magnifies.
 #pragma once
 
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -58,6 +60,22 @@ class TextureSet {
  private:
   std::vector<std::vector<MipLevel>> chains_;  // by texture index; empty for unused ones
   std::vector<TextureSampler> samplers_;
+};
+
+// A scene's TextureSet built once, on first use, and shared: every Shader
+// of a frame (the camera's, the shadow maps', the ray caster's) and every
+// frame of a bench run asks the same holder (SceneAnalysis::textureSet)
+// instead of decoding and halving every texture again. Thread-safe.
+class SharedTextureSet {
+ public:
+  // The set of `scene`; built on the first call. A different scene than the
+  // first call's gets a set of its own, not kept.
+  std::shared_ptr<const TextureSet> get(const Scene& scene) const;
+
+ private:
+  mutable std::once_flag once_;
+  mutable std::shared_ptr<const TextureSet> set_;
+  mutable const Scene* scene_ = nullptr;
 };
 
 }  // namespace rastray

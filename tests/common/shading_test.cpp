@@ -178,5 +178,37 @@ TEST(ShadingEnergy, NoMaterialReturnsMoreThanArrives) {
         }
 }
 
+// Mip chains are built once per scene: every Shader made from one analysis
+// (or a copy of it: the frame, the shadow maps' unlit shader, the ray
+// caster) shares one TextureSet; a different scene gets its own.
+TEST(Shading, ShadersOfOneAnalysisShareTheSceneTextures) {
+  Material m;
+  m.baseColorTexture = 0;
+  Scene s = triangleScene(m);
+  TextureImage img;
+  img.width = 8;
+  img.height = 4;
+  img.rgba8.assign(size_t(8 * 4 * 4), 200);
+  s.images.push_back(img);
+  Texture t;
+  t.image = 0;
+  s.textures.push_back(t);
+  const SceneAnalysis analysis = analyzeScene(s);
+  ASSERT_TRUE(analysis.textures);
+  const Camera cam = makeCamera(s, {}, 8, 8);
+  const Shader a(s, analysis, cam, {}, nullptr, nullptr);
+  const SceneAnalysis copy = analysis;
+  const Shader b(s, copy, cam, {}, nullptr, nullptr);
+  EXPECT_EQ(&a.textures(), &b.textures());
+  EXPECT_EQ(a.textures().levelCount(0), 4u);  // 8x4, 4x2, 2x1, 1x1
+  const Scene other = s;                      // same content, another scene: not the cached set
+  const Shader c(other, analysis, cam, {}, nullptr, nullptr);
+  EXPECT_NE(&a.textures(), &c.textures());
+  EXPECT_EQ(c.textures().levelCount(0), 4u);
+  // No textures needed: an empty set, nothing decoded.
+  const Scene plain = triangleScene(Material{});
+  EXPECT_TRUE(Shader(plain, analyzeScene(plain), cam, {}, nullptr, nullptr).textures().empty());
+}
+
 }  // namespace
 }  // namespace rastray
