@@ -28,9 +28,12 @@
 
 namespace rastray {
 
+// No default values: a ClipResult's nine slots stay unwritten until the
+// clipper fills them (only the first `count` are ever read), so clipping a
+// triangle does not first zero 500 bytes.
 struct ClipVertex {
-  glm::dvec4 position{0.0};  // (x, y, d, w) as above
-  glm::dvec3 bary{0.0};      // weights of the original stored vertices
+  glm::dvec4 position;  // (x, y, d, w) as above
+  glm::dvec3 bary;      // weights of the original stored vertices
 };
 
 // 3 vertices + at most one more per plane (6 planes).

@@ -69,16 +69,17 @@ int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) 
 SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& ds,
                            const ClipVertex v[3], CullMode cull, TriangleSetup* t) {
   const double U = double(grid.unitsPerPixel);
+  glm::dvec2 image[3];  // unsnapped image positions, reused by the planes
   glm::i64vec2 snapped[3];
   for (int i = 0; i < 3; ++i) {
-    const glm::dvec2 image = space.imageOf(v[i].position);
+    image[i] = space.imageOf(v[i].position);
     // Clamping only moves vertices that the guard-band clip left a rounding
     // error beyond it; inside the range it is the identity.
     const auto snap = [&](double c) {
       const double s = std::round(c * U);
       return int64_t(std::clamp(s, -double(kMaxCoordinateUnits), double(kMaxCoordinateUnits)));
     };
-    snapped[i] = {snap(image.x), snap(image.y)};
+    snapped[i] = {snap(image[i].x), snap(image[i].y)};
   }
   const int64_t area2 = (snapped[1].x - snapped[0].x) * (snapped[2].y - snapped[0].y) -
                         (snapped[1].y - snapped[0].y) * (snapped[2].x - snapped[0].x);
@@ -128,9 +129,8 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
   // whose unsnapped area vanishes fall back to the snapped positions.
   double x[3], y[3], z[3], invW[3], dOverW[3], b1[3], b2[3];
   for (int i = 0; i < 3; ++i) {
-    const glm::dvec2 image = space.imageOf(cv[i]->position);
-    x[i] = image.x;
-    y[i] = image.y;
+    x[i] = image[order[i]].x;
+    y[i] = image[order[i]].y;
   }
   double areaPixels = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
   if (!(areaPixels > 0.0) || !std::isfinite(areaPixels)) {
@@ -198,7 +198,8 @@ void setupChunk(const Scene& scene, const ClipSpace& space, const SampleGrid& gr
     const glm::uvec3 idx = scene.triangles[inst.firstTriangle + k];
     const glm::dvec3 p[3] = {glm::dvec3(scene.positions[idx.x]), glm::dvec3(scene.positions[idx.y]),
                              glm::dvec3(scene.positions[idx.z])};
-    if (isDegenerate(scene, inst.firstTriangle + k)) {
+    // isDegenerate (common/scene.h) on the positions already loaded.
+    if (glm::cross(p[1] - p[0], p[2] - p[0]) == glm::dvec3(0.0)) {
       ++n.degenerate;  // SPEC §1: zero world area covers nothing
       continue;
     }
