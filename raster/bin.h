@@ -78,10 +78,14 @@ void forEachBinnedTile(const TileGrid& grid, int64_t unitsPerPixel, const Sample
 // bins[tile] = indices into `setups` (those accepted by `select`) binned to
 // the tile, increasing. In parallel: per-chunk counts, exact bin sizes
 // from their prefix sums in chunk order, then each chunk fills its own
-// slots, so the bins are the serial result whatever the thread count.
+// slots, so the bins are the serial result whatever the thread count. The
+// counting pass notes each setup's fate in 4 bytes (not selected, one tile,
+// several tiles), so the filling pass reads the 272-byte setups again only
+// for triangles that span tiles.
 template <typename Select>
 std::vector<std::vector<uint32_t>> binTriangles(const TileGrid& grid, const SampleGrid& samples,
                                                 const std::vector<TriangleSetup>& setups, Select select) {
+  constexpr uint32_t kNotSelected = 0xFFFFFFFFu, kSeveralTiles = 0xFFFFFFFEu;
   const size_t tiles = size_t(grid.count());
   std::vector<std::vector<uint32_t>> bins(tiles);
   if (setups.empty()) return bins;
@@ -92,18 +96,27 @@ std::vector<std::vector<uint32_t>> binTriangles(const TileGrid& grid, const Samp
   const SampleBox box(samples);
   const int64_t U = samples.unitsPerPixel;
   std::vector<uint32_t> slot(chunks * tiles, 0);  // counts, then each chunk's next slot per tile
+  std::vector<uint32_t> fate(setups.size());      // its one tile, or kNotSelected, kSeveralTiles
   const auto forChunks = [&](auto&& body) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t c = r.begin(); c != r.end(); ++c) {
-        uint32_t* s = slot.data() + c * tiles;
-        const size_t end = std::min(setups.size(), (c + 1) * perChunk);
-        for (size_t i = c * perChunk; i < end; ++i)
-          if (select(setups[i]))
-            forEachBinnedTile(grid, U, box, setups[i], [&](int tile) { body(s, tile, i); });
-      }
+      for (size_t c = r.begin(); c != r.end(); ++c)
+        body(slot.data() + c * tiles, c * perChunk, std::min(setups.size(), (c + 1) * perChunk));
     });
   };
-  forChunks([&](uint32_t* s, int tile, size_t) { ++s[tile]; });
+  forChunks([&](uint32_t* count, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      if (!select(setups[i])) {
+        fate[i] = kNotSelected;
+        continue;
+      }
+      uint32_t first = kNotSelected, n = 0;
+      forEachBinnedTile(grid, U, box, setups[i], [&](int tile) {
+        ++count[tile];
+        if (n++ == 0) first = uint32_t(tile);
+      });
+      fate[i] = n == 1 ? first : n == 0 ? kNotSelected : kSeveralTiles;
+    }
+  });
   for (size_t tile = 0; tile < tiles; ++tile) {
     uint32_t total = 0;
     for (size_t c = 0; c < chunks; ++c) {
@@ -113,7 +126,17 @@ std::vector<std::vector<uint32_t>> binTriangles(const TileGrid& grid, const Samp
     }
     bins[tile].resize(total);
   }
-  forChunks([&](uint32_t* s, int tile, size_t i) { bins[size_t(tile)][s[tile]++] = uint32_t(i); });
+  forChunks([&](uint32_t* next, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      if (fate[i] == kNotSelected) continue;
+      if (fate[i] != kSeveralTiles) {
+        bins[fate[i]][next[fate[i]]++] = uint32_t(i);
+        continue;
+      }
+      forEachBinnedTile(grid, U, box, setups[i],
+                        [&](int tile) { bins[size_t(tile)][next[tile]++] = uint32_t(i); });
+    }
+  });
   return bins;
 }
 
