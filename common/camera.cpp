@@ -60,29 +60,23 @@ glm::dvec2 Camera::ndcScale() const {
 Ray Camera::primaryRay(glm::dvec2 image) const { return PrimaryRays(*this)(image); }
 
 PrimaryRays::PrimaryRays(const Camera& camera)
-    : camera_(camera), scale_(camera.ndcScale()), eye_(camera.eye()), forward_(camera.forward()) {}
+    : camera_(camera), scale_(camera.ndcScale()), eye_(camera.eye()), forward_(camera.forward()) {
+  // glm's mat4 × vec4 adds m2·v.z + m3·v.w as one term; with v.z = −1 and
+  // v.w = 0 for every perspective ray it is this constant (signed zeros
+  // included: m3·0 is −0 for a negative eye coordinate).
+  const glm::dmat4& m = camera.worldFromView;
+  for (int k = 0; k < 3; ++k) constantPart_[k] = m[2][k] * -1.0 + m[3][k] * 0.0;
+}
 
-Ray PrimaryRays::operator()(glm::dvec2 image) const {
+Ray PrimaryRays::orthographic(glm::dvec2 image) const {
   const Camera& camera = camera_;
   const glm::dvec2 ndc = camera.ndcFromImage(image);
-  const glm::dvec2 scale = scale_;
   Ray ray;
-  if (camera.projection == Projection::Orthographic) {
-    ray.origin = glm::dvec3(camera.worldFromView * glm::dvec4(ndc.x * scale.x, ndc.y * scale.y, 0.0, 1.0));
-    ray.direction = forward_;
-    ray.depthPerT = 1.0;
-    ray.tNear = camera.znear;
-    ray.tFar = camera.zfar;
-    return ray;
-  }
-  // The point on the view plane at depth 1; its length converts depth to t.
-  const glm::dvec3 viewDir(ndc.x * scale.x, ndc.y * scale.y, -1.0);
-  const double length = glm::length(viewDir);
-  ray.origin = eye_;
-  ray.direction = glm::normalize(glm::dvec3(camera.worldFromView * glm::dvec4(viewDir, 0.0)));
-  ray.depthPerT = 1.0 / length;
-  ray.tNear = camera.znear * length;
-  ray.tFar = camera.zfar * length;  // inf stays inf
+  ray.origin = glm::dvec3(camera.worldFromView * glm::dvec4(ndc.x * scale_.x, ndc.y * scale_.y, 0.0, 1.0));
+  ray.direction = forward_;
+  ray.depthPerT = 1.0;
+  ray.tNear = camera.znear;
+  ray.tFar = camera.zfar;
   return ray;
 }
 

@@ -83,18 +83,47 @@ struct Camera {
 };
 
 // Camera::primaryRay with what depends on the camera alone (the NDC scale,
-// a tangent; the eye; the forward direction) computed once: bit-identical
-// rays (Camera::primaryRay is this), for loops over many image positions.
-// Holds a reference: the camera must outlive it.
+// a tangent; the eye; the forward direction; the constant half of the
+// view-to-world product) computed once: bit-identical rays
+// (Camera::primaryRay is this), for loops over many image positions.
+// Inline, so that the ray is built in the caller's storage (returned
+// through memory, it was written in 8-byte and read back in 16-byte
+// pieces: a store-forwarding stall per ray). Holds a reference: the
+// camera must outlive it.
 class PrimaryRays {
  public:
   explicit PrimaryRays(const Camera& camera);
-  Ray operator()(glm::dvec2 image) const;
+  // always_inline: GCC's size limit kept it out of line at call sites
+  // such as `g.ray = rays(position)`, where the copy stalled.
+  [[gnu::always_inline]] Ray operator()(glm::dvec2 image) const {
+    if (camera_.projection == Projection::Orthographic) return orthographic(image);
+    const glm::dvec2 ndc = camera_.ndcFromImage(image);
+    // The point on the view plane at depth 1; its length converts depth to t.
+    const glm::dvec3 viewDir(ndc.x * scale_.x, ndc.y * scale_.y, -1.0);
+    const double length = glm::length(viewDir);
+    // worldFromView · (viewDir, 0) as glm evaluates it, (m0·x + m1·y) +
+    // (m2·z + m3·w), with the second sum (z = −1, w = 0 for every ray)
+    // taken from constantPart_: the same operations on the same values.
+    const glm::dmat4& m = camera_.worldFromView;
+    const glm::dvec3 world((m[0].x * viewDir.x + m[1].x * viewDir.y) + constantPart_.x,
+                           (m[0].y * viewDir.x + m[1].y * viewDir.y) + constantPart_.y,
+                           (m[0].z * viewDir.x + m[1].z * viewDir.y) + constantPart_.z);
+    Ray ray;
+    ray.origin = eye_;
+    ray.direction = glm::normalize(world);
+    ray.depthPerT = 1.0 / length;
+    ray.tNear = camera_.znear * length;
+    ray.tFar = camera_.zfar * length;  // inf stays inf
+    return ray;
+  }
 
  private:
+  Ray orthographic(glm::dvec2 image) const;
+
   const Camera& camera_;
   glm::dvec2 scale_;
   glm::dvec3 eye_, forward_;
+  glm::dvec3 constantPart_;  // m2·(−1) + m3·0 of worldFromView, per component
 };
 
 // Rebases the scene (rebaseScene) on the point `mode` names: the eye of the

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 
 namespace rastray {
 
@@ -19,65 +20,154 @@ glm::dvec2 planeBarycentrics(const glm::dvec3& p, const glm::dvec3& a, const glm
   return {(d22 * dp1 - d12 * dp2) / det, (d11 * dp2 - d12 * dp1) / det};
 }
 
-}  // namespace
+// The bits of the three stored float vertices of a triangle: what every
+// per-triangle quantity below is a function of, and so the key of the
+// per-thread memos (bits, so that −0 and NaN corners are told apart).
+// Compared in registers, straight from the scene's arrays: a key first
+// copied into a local struct was stored in 4- and 8-byte pieces and read
+// back wider, stalling store-to-load forwarding on every call.
+using CornerBits = std::array<uint32_t, 9>;
 
-SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit) {
-  SurfacePoint sp;
-  sp.instance = hit.instance;
-  sp.triangle = hit.triangle;
-  sp.b1 = hit.b1;
-  sp.b2 = hit.b2;
-  const Instance& inst = scene.instances[hit.instance];
-  sp.material = &scene.materials[inst.material];
-  const glm::uvec3 t = scene.triangle(hit.instance, hit.triangle);
-  const double b0 = 1.0 - double(hit.b1) - double(hit.b2);
-  const glm::dvec3 p0(scene.positions[t.x]), p1(scene.positions[t.y]), p2(scene.positions[t.z]);
-  sp.position = b0 * p0 + double(hit.b1) * p1 + double(hit.b2) * p2;
+inline uint32_t bitsOf(const float& f) {
+  uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
 
+inline bool sameCorners(const CornerBits& key, const glm::vec3& p0, const glm::vec3& p1,
+                        const glm::vec3& p2) {
+  return ((key[0] ^ bitsOf(p0.x)) | (key[1] ^ bitsOf(p0.y)) | (key[2] ^ bitsOf(p0.z)) |
+          (key[3] ^ bitsOf(p1.x)) | (key[4] ^ bitsOf(p1.y)) | (key[5] ^ bitsOf(p1.z)) |
+          (key[6] ^ bitsOf(p2.x)) | (key[7] ^ bitsOf(p2.y)) | (key[8] ^ bitsOf(p2.z))) == 0;
+}
+
+inline CornerBits cornerBits(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2) {
+  return {bitsOf(p0.x), bitsOf(p0.y), bitsOf(p0.z), bitsOf(p1.x), bitsOf(p1.y),
+          bitsOf(p1.z), bitsOf(p2.x), bitsOf(p2.y), bitsOf(p2.z)};
+}
+
+// Consecutive samples (a tile's pixels, a packet's rays) mostly hit the
+// triangle the previous one hit, so each thread remembers the last
+// triangle's derived data. A memo hit returns exactly the values the
+// computation would (they depend on the corners alone, compared bit for
+// bit), so results do not depend on the order samples arrive in. Plain
+// aggregates without initializers: thread storage starts zero-filled
+// (valid false) and needs no per-access initialization check.
+struct PlaneMemo {
+  bool valid;
+  CornerBits key;
+  int slot1, slot2;      // canonical (lexicographic) rank of stored corners 1 and 2
+  glm::dvec3 a, e1, e2;  // first canonical corner, edges to the other two
+};
+struct NormalMemo {
+  bool valid;
+  CornerBits key;
+  glm::dvec3 normal;  // unit cross(p1 − p0, p2 − p0), (0, 0, 1) when degenerate
+};
+thread_local PlaneMemo planeMemo;
+thread_local NormalMemo normalMemo;
+
+// The unit face normal of stored corners p0, p1, p2 (CCW front).
+glm::dvec3 faceNormal(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2) {
   const glm::dvec3 n = glm::cross(p1 - p0, p2 - p0);
   const double length = glm::length(n);
-  sp.geometricNormal = length > 0.0 ? n / length : glm::dvec3(0.0, 0.0, 1.0);
+  return length > 0.0 ? n / length : glm::dvec3(0.0, 0.0, 1.0);
+}
+
+// makeSurfacePoint from the hit's fields as values: callers pass b1 and b2
+// in registers (a SampleHit just returned through memory, read back as
+// one 8-byte pair, stalled store-to-load forwarding).
+SurfacePoint surfacePointAt(const Scene& scene, uint32_t instance, uint32_t triangle, float b1, float b2) {
+  SurfacePoint sp;
+  sp.instance = instance;
+  sp.triangle = triangle;
+  sp.b1 = b1;
+  sp.b2 = b2;
+  const Instance& inst = scene.instances[instance];
+  sp.material = &scene.materials[inst.material];
+  const glm::uvec3 t = scene.triangle(instance, triangle);
+  const double b0 = 1.0 - double(b1) - double(b2);
+  const glm::vec3 &f0 = scene.positions[t.x], &f1 = scene.positions[t.y], &f2 = scene.positions[t.z];
+  const glm::dvec3 p0(f0), p1(f1), p2(f2);
+  sp.position = b0 * p0 + double(b1) * p1 + double(b2) * p2;
+
+  // The face normal (a square root and three divisions) from the memo when
+  // the previous point was on the same triangle.
+  NormalMemo& memo = normalMemo;
+  if (!memo.valid || !sameCorners(memo.key, f0, f1, f2)) {
+    memo.key = cornerBits(f0, f1, f2);
+    memo.normal = faceNormal(p0, p1, p2);
+    memo.valid = true;
+  }
+  sp.geometricNormal = memo.normal;
   sp.shadingNormal = sp.geometricNormal;
   if (inst.normals == NormalSource::Authored) {
-    const glm::dvec3 ns = b0 * glm::dvec3(scene.normals[t.x]) +
-                          double(hit.b1) * glm::dvec3(scene.normals[t.y]) +
-                          double(hit.b2) * glm::dvec3(scene.normals[t.z]);
+    const glm::dvec3 ns = b0 * glm::dvec3(scene.normals[t.x]) + double(b1) * glm::dvec3(scene.normals[t.y]) +
+                          double(b2) * glm::dvec3(scene.normals[t.z]);
     const double nl = glm::length(ns);
     if (nl > 0.0 && std::isfinite(nl)) sp.shadingNormal = ns / nl;  // zero: keep the face normal
   }
   if (inst.hasTexcoords)
-    sp.uv = float(b0) * scene.texcoords[t.x] + hit.b1 * scene.texcoords[t.y] + hit.b2 * scene.texcoords[t.z];
+    sp.uv = float(b0) * scene.texcoords[t.x] + b1 * scene.texcoords[t.y] + b2 * scene.texcoords[t.z];
   if (inst.hasColors)
-    sp.color = float(b0) * scene.colors[t.x] + hit.b1 * scene.colors[t.y] + hit.b2 * scene.colors[t.z];
+    sp.color = float(b0) * scene.colors[t.x] + b1 * scene.colors[t.y] + b2 * scene.colors[t.z];
   return sp;
+}
+
+}  // namespace
+
+SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit) {
+  return surfacePointAt(scene, hit.instance, hit.triangle, hit.b1, hit.b2);
+}
+
+SurfacePoint surfacePointOnRay(const Scene& scene, const Ray& ray, const SampleHit& hit) {
+  // refineHit's steps, its result kept in registers.
+  if (!hit.valid()) return makeSurfacePoint(scene, hit);
+  double t;
+  glm::dvec2 b;
+  glm::dvec2 clamped;
+  if (!intersectTrianglePlane(scene, hit.instance, hit.triangle, ray, &t, &b) ||
+      !refinedBarycentrics(ray, t, b, &clamped))
+    return makeSurfacePoint(scene, hit);
+  return surfacePointAt(scene, hit.instance, hit.triangle, float(clamped.x), float(clamped.y));
 }
 
 bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle, const Ray& ray,
                             double* t, glm::dvec2* barycentrics) {
   const glm::uvec3 v = scene.triangle(instance, triangle);
-  // The corners in a canonical (lexicographic) order, so that coincident
-  // triangles listed with their vertices in another order (duplicated or
-  // reversed faces) get bit-identical t: their layers then tie exactly and
-  // are ordered by (instance, triangle) in both renderers.
-  std::array<glm::dvec3, 3> corner = {glm::dvec3(scene.positions[v.x]), glm::dvec3(scene.positions[v.y]),
-                                      glm::dvec3(scene.positions[v.z])};
-  // Three compare-exchanges (a sorting network) instead of std::sort: the
-  // same order for distinct corners; equal corners make det 0 below, so
-  // their order never shows.
-  auto less = [&](int i, int j) {
-    const glm::dvec3 &p = corner[size_t(i)], &q = corner[size_t(j)];
-    if (p.x != q.x) return p.x < q.x;
-    if (p.y != q.y) return p.y < q.y;
-    return p.z < q.z;
-  };
-  std::array<int, 3> order = {0, 1, 2};
-  if (less(order[1], order[0])) std::swap(order[0], order[1]);
-  if (less(order[2], order[1])) std::swap(order[1], order[2]);
-  if (less(order[1], order[0])) std::swap(order[0], order[1]);
-  const glm::dvec3 &a = corner[size_t(order[0])], &b = corner[size_t(order[1])],
-                   &c = corner[size_t(order[2])];
+  const glm::vec3 &f0 = scene.positions[v.x], &f1 = scene.positions[v.y], &f2 = scene.positions[v.z];
+  PlaneMemo& memo = planeMemo;
+  if (!memo.valid || !sameCorners(memo.key, f0, f1, f2)) {
+    // The corners in a canonical (lexicographic) order, so that coincident
+    // triangles listed with their vertices in another order (duplicated or
+    // reversed faces) get bit-identical t: their layers then tie exactly
+    // and are ordered by (instance, triangle) in both renderers.
+    const std::array<glm::dvec3, 3> corner = {glm::dvec3(f0), glm::dvec3(f1), glm::dvec3(f2)};
+    // Three compare-exchanges (a sorting network) instead of std::sort: the
+    // same order for distinct corners; equal corners make det 0 below, so
+    // their order never shows.
+    auto less = [&](int i, int j) {
+      const glm::dvec3 &p = corner[size_t(i)], &q = corner[size_t(j)];
+      if (p.x != q.x) return p.x < q.x;
+      if (p.y != q.y) return p.y < q.y;
+      return p.z < q.z;
+    };
+    std::array<int, 3> order = {0, 1, 2};
+    if (less(order[1], order[0])) std::swap(order[0], order[1]);
+    if (less(order[2], order[1])) std::swap(order[1], order[2]);
+    if (less(order[1], order[0])) std::swap(order[0], order[1]);
+    memo.key = cornerBits(f0, f1, f2);
+    for (int slot = 0; slot < 3; ++slot) {
+      if (order[size_t(slot)] == 1) memo.slot1 = slot;
+      if (order[size_t(slot)] == 2) memo.slot2 = slot;
+    }
+    memo.a = corner[size_t(order[0])];
+    memo.e1 = corner[size_t(order[1])] - memo.a;
+    memo.e2 = corner[size_t(order[2])] - memo.a;
+    memo.valid = true;
+  }
+  const glm::dvec3 a = memo.a, e1 = memo.e1, e2 = memo.e2;
   // Möller–Trumbore in double, without the inside test.
-  const glm::dvec3 e1 = b - a, e2 = c - a;
   const glm::dvec3 p = glm::cross(ray.direction, e2);
   const double det = glm::dot(e1, p);
   if (!(std::abs(det) > 0.0)) return false;
@@ -87,12 +177,10 @@ bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t tria
   const glm::dvec3 q = glm::cross(s, e1);
   const double w = glm::dot(ray.direction, q) * inv;
   *t = glm::dot(e2, q) * inv;
-  // Back to the stored order: weight[k] belongs to stored corner k.
-  std::array<double, 3> weight{};
-  weight[size_t(order[0])] = 1.0 - u - w;
-  weight[size_t(order[1])] = u;
-  weight[size_t(order[2])] = w;
-  *barycentrics = glm::dvec2(weight[1], weight[2]);
+  // Back to the stored order: canonical corner 0 weighs 1 − u − w, 1 u, 2 w.
+  const double w0 = 1.0 - u - w;
+  auto weightOf = [&](int slot) { return slot == 0 ? w0 : slot == 1 ? u : w; };
+  *barycentrics = glm::dvec2(weightOf(memo.slot1), weightOf(memo.slot2));
   return std::isfinite(*t) && std::isfinite(u) && std::isfinite(w);
 }
 
@@ -102,21 +190,6 @@ SampleHit refineHit(const Scene& scene, const Ray& ray, const SampleHit& hit) {
   glm::dvec2 b;
   if (!intersectTrianglePlane(scene, hit.instance, hit.triangle, ray, &t, &b)) return hit;
   return refineHitAt(ray, hit, t, b);
-}
-
-SampleHit refineHitAt(const Ray& ray, const SampleHit& hit, double t, glm::dvec2 b) {
-  // A plane behind the origin (or at it) is not what the renderer saw:
-  // keep its hit.
-  if (!(t > 0.0) || !std::isfinite(t * ray.depthPerT)) return hit;
-  // Into the triangle (header): at grazing angles the plane point may fall
-  // just outside, and attributes must not be extrapolated there.
-  b = glm::max(b, glm::dvec2(0.0));
-  if (b.x + b.y > 1.0) b /= b.x + b.y;
-  SampleHit refined = hit;
-  refined.b1 = float(b.x);
-  refined.b2 = float(b.y);
-  refined.depth = float(t * ray.depthPerT);
-  return refined;
 }
 
 TextureFootprint pixelFootprint(const Scene& scene, const Camera& camera, const SurfacePoint& point,

@@ -3,6 +3,8 @@
 // b1, b2) into geometry.
 #pragma once
 
+#include <cmath>
+
 #include <glm/glm.hpp>
 
 #include "common/camera.h"
@@ -30,6 +32,12 @@ struct SurfacePoint {
 };
 
 SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit);
+// makeSurfacePoint(scene, refineHit(scene, ray, hit)), bit-identical, in one
+// call: the refined barycentrics go on in registers, not through a
+// SampleHit in memory (written in 4- and 8-byte pieces and read back as an
+// 8-byte pair: a store-forwarding stall per sample). For shading a hit
+// along its primary ray.
+SurfacePoint surfacePointOnRay(const Scene& scene, const Ray& ray, const SampleHit& hit);
 
 // Where a ray meets the plane of stored triangle (instance, triangle), in
 // double precision: t along the ray and barycentrics (b1, b2), with no
@@ -53,8 +61,32 @@ bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t tria
 SampleHit refineHit(const Scene& scene, const Ray& ray, const SampleHit& hit);
 // refineHit from the plane point (t, barycentrics) intersectTrianglePlane
 // already returned true for this hit and ray: the same result, without
-// intersecting the plane again.
-SampleHit refineHitAt(const Ray& ray, const SampleHit& hit, double t, glm::dvec2 barycentrics);
+// intersecting the plane again. Inline: a 20-byte SampleHit returned
+// through memory and copied on was read back in wider pieces than it was
+// written (a store-forwarding stall per sample).
+//
+// refinedBarycentrics is its test and clamp: false when the hit is kept
+// (the plane is not ahead of the ray), else the clamped barycentrics.
+inline bool refinedBarycentrics(const Ray& ray, double t, glm::dvec2 b, glm::dvec2* clamped) {
+  // A plane behind the origin (or at it) is not what the renderer saw:
+  // keep its hit.
+  if (!(t > 0.0) || !std::isfinite(t * ray.depthPerT)) return false;
+  // Into the triangle (above): at grazing angles the plane point may fall
+  // just outside, and attributes must not be extrapolated there.
+  b = glm::max(b, glm::dvec2(0.0));
+  if (b.x + b.y > 1.0) b /= b.x + b.y;
+  *clamped = b;
+  return true;
+}
+inline SampleHit refineHitAt(const Ray& ray, const SampleHit& hit, double t, glm::dvec2 b) {
+  glm::dvec2 clamped;
+  if (!refinedBarycentrics(ray, t, b, &clamped)) return hit;
+  SampleHit refined = hit;
+  refined.b1 = float(clamped.x);
+  refined.b2 = float(clamped.y);
+  refined.depth = float(t * ray.depthPerT);
+  return refined;
+}
 
 // Texture-space footprint of one pixel at a surface point: d(uv)/dx and
 // d(uv)/dy per image pixel. Both renderers compute it the same way, from

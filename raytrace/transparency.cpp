@@ -19,7 +19,8 @@ bool maskCovers(const CasterState& state, const HitGather& g, const SurfacePoint
 bool isFrontFacing(const Scene& scene, const GatheredHit& hit, const glm::dvec3& direction);
 RTCRayHit makeRayHit(const glm::vec3& origin, const glm::vec3& direction, float tnear, float tfar,
                      unsigned id);
-SurfaceCrossing toSurfaceCrossing(const Scene& scene, const Ray& ray, const GatheredHit& h);
+void appendSurfaceCrossing(const Scene& scene, const Ray& ray, const GatheredHit& h,
+                           std::vector<SurfaceCrossing>* crossings);
 // At the end: the detail of when two hits are one crossing.
 void sortAndMergeCrossings(const Scene& scene, const Ray& ray, std::vector<GatheredHit>* hits);
 
@@ -93,7 +94,7 @@ SurfacePoint surfacePointOf(const Scene& scene, const Ray& ray, const GatheredHi
   h.b1 = hit.u;
   h.b2 = hit.v;
   h.depth = float(double(hit.traversalT) * ray.depthPerT);
-  return makeSurfacePoint(scene, refineHit(scene, ray, h));
+  return surfacePointOnRay(scene, ray, h);
 }
 
 // --- traversals -----------------------------------------------------------------
@@ -171,7 +172,7 @@ void collectCrossings(const CasterState& state, HitGather& g, const GatheredHit&
   if (g.hits.empty()) {
     // Nothing gathered (every opaque scene): the list is the stopping hit
     // alone, as the general path below would make it.
-    if (closest.instance != kNoId) crossings->push_back(toSurfaceCrossing(state.scene, g.ray, closest));
+    if (closest.instance != kNoId) appendSurfaceCrossing(state.scene, g.ray, closest, crossings);
     return;
   }
   if (closest.instance != kNoId) {
@@ -183,7 +184,7 @@ void collectCrossings(const CasterState& state, HitGather& g, const GatheredHit&
     g.hits.push_back(closest);
   }
   if (g.hits.size() > 1) sortAndMergeCrossings(state.scene, g.ray, &g.hits);
-  for (const GatheredHit& h : g.hits) crossings->push_back(toSurfaceCrossing(state.scene, g.ray, h));
+  for (const GatheredHit& h : g.hits) appendSurfaceCrossing(state.scene, g.ray, h, crossings);
   std::sort(crossings->begin(), crossings->end(), [](const SurfaceCrossing& a, const SurfaceCrossing& b) {
     if (a.planeT != b.planeT) return a.planeT < b.planeT;
     if (a.refined.instance != b.refined.instance) return a.refined.instance < b.refined.instance;
@@ -198,27 +199,29 @@ void collectCrossings(const CasterState& state, HitGather& g, const GatheredHit&
 
 namespace {
 
-// A gathered hit as a surface of the ray's list: refined in double.
-SurfaceCrossing toSurfaceCrossing(const Scene& scene, const Ray& ray, const GatheredHit& h) {
-  SampleHit traversed;
-  traversed.instance = h.instance;
-  traversed.triangle = h.triangle;
-  traversed.b1 = h.u;
-  traversed.b2 = h.v;
-  traversed.depth = float(double(h.traversalT) * ray.depthPerT);
-  SurfaceCrossing crossing;
+// A gathered hit appended to the ray's surface list, refined in double.
+void appendSurfaceCrossing(const Scene& scene, const Ray& ray, const GatheredHit& h,
+                           std::vector<SurfaceCrossing>* crossings) {
+  // Filled in place in the list: a crossing (or its SampleHit) built apart
+  // and copied in was read back in wider pieces than it was written (a
+  // store-forwarding stall per hit).
+  SurfaceCrossing& crossing = crossings->emplace_back();
+  SampleHit& hit = crossing.refined;
+  hit.instance = h.instance;
+  hit.triangle = h.triangle;
+  hit.b1 = h.u;
+  hit.b2 = h.v;
+  hit.depth = float(double(h.traversalT) * ray.depthPerT);
+  crossing.traversalDepth = hit.depth;
   crossing.planeT = h.traversalT;
-  crossing.refined = traversed;
   double t;
   glm::dvec2 b;
   // One plane intersection for both: refineHitAt is refineHit from it.
   if (intersectTrianglePlane(scene, h.instance, h.triangle, ray, &t, &b)) {
     crossing.planeT = t;
-    crossing.refined = refineHitAt(ray, traversed, t, b);
+    hit = refineHitAt(ray, hit, t, b);
   }
-  crossing.traversalDepth = traversed.depth;
   crossing.blend = scene.materialOf(h.instance).alphaMode == AlphaMode::Blend;
-  return crossing;
 }
 
 // --- one hit per crossing ----------------------------------------------------------

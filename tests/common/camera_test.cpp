@@ -1,6 +1,8 @@
 #include "common/camera.h"
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -107,6 +109,72 @@ TEST(Camera, OverridesLookAt) {
   EXPECT_NEAR(cam.yfov, kPi / 3, 1e-15);
   const Ray centre = cam.primaryRay({16, 16});
   EXPECT_NEAR(centre.direction.x, -1.0, 1e-15);
+}
+
+// The perspective ray exactly as Camera::primaryRay computed it before
+// PrimaryRays hoisted the camera-only part of the matrix product: the
+// full glm expressions, which the hoisted path must match bit for bit.
+Ray referencePerspectiveRay(const Camera& camera, glm::dvec2 image) {
+  const glm::dvec2 ndc = camera.ndcFromImage(image);
+  const glm::dvec2 scale = camera.ndcScale();
+  const glm::dvec3 viewDir(ndc.x * scale.x, ndc.y * scale.y, -1.0);
+  const double length = glm::length(viewDir);
+  Ray ray;
+  ray.origin = camera.eye();
+  ray.direction = glm::normalize(glm::dvec3(camera.worldFromView * glm::dvec4(viewDir, 0.0)));
+  ray.depthPerT = 1.0 / length;
+  ray.tNear = camera.znear * length;
+  ray.tFar = camera.zfar * length;
+  return ray;
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(Camera, PrimaryRaysMatchTheFullMatrixProductBitForBit) {
+  const Scene scene = boxScene({-1, -1, -1}, {1, 1, 1});
+  // Axis-aligned views have exact zeros in the matrix (signed zeros are
+  // where a hoisted sum could differ); eyes with negative coordinates make
+  // m3·0 a −0; oblique and far-away ones exercise rounding.
+  std::vector<CameraOverrides> views(5);
+  views[1].eye = glm::dvec3(-3, -2, -7);
+  views[1].target = glm::dvec3(0.25, 0.5, -0.125);
+  views[2].eye = glm::dvec3(1e6 + 0.3, -2e5, 7.7);
+  views[2].target = glm::dvec3(0, 0, 0);
+  views[2].up = glm::dvec3(0.1, 1, 0.2);
+  views[3].eye = glm::dvec3(0, 5, 0);
+  views[3].target = glm::dvec3(0, 0, 0);
+  views[3].up = glm::dvec3(0, 0, -1);
+  views[4].eye = glm::dvec3(-0.0, -4, -0.0);
+  views[4].target = glm::dvec3(-0.0, 0, -0.0);
+  views[4].up = glm::dvec3(1, 0, 0);
+  views[4].zfar = 100.0;
+  uint32_t state = 12345u;
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return double(state >> 8) / double(1u << 24);
+  };
+  for (const CameraOverrides& o : views) {
+    const Camera cam = makeCamera(scene, o, 97, 61);
+    const PrimaryRays rays(cam);
+    for (int i = 0; i < 4000; ++i) {
+      // Pixel corners, centres and random points, some outside the image.
+      const glm::dvec2 image = i < 200 ? glm::dvec2(i % 98, (i * 7) % 62) + 0.5 * double(i % 2)
+                                       : glm::dvec2(next() * 120.0 - 10.0, next() * 80.0 - 10.0);
+      const Ray a = rays(image), b = referencePerspectiveRay(cam, image);
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_TRUE(sameBits(a.origin[k], b.origin[k]))
+            << "view " << &o - views.data() << " image " << image.x;
+        ASSERT_TRUE(sameBits(a.direction[k], b.direction[k]))
+            << "view " << &o - views.data() << " image " << image.x << ", " << image.y << " axis " << k;
+      }
+      ASSERT_TRUE(sameBits(a.depthPerT, b.depthPerT));
+      ASSERT_TRUE(sameBits(a.tNear, b.tNear));
+      ASSERT_TRUE(sameBits(a.tFar, b.tFar));
+      const Ray c = cam.primaryRay(image);
+      ASSERT_TRUE(sameBits(c.direction.x, a.direction.x) && sameBits(c.direction.y, a.direction.y) &&
+                  sameBits(c.direction.z, a.direction.z));
+    }
+  }
 }
 
 TEST(Camera, ImpossibleSettingsAreInputErrors) {

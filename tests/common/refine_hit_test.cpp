@@ -2,7 +2,11 @@
 // ahead of the ray, and refined barycentrics never leave the triangle.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
 
 #include "common/surface.h"
 
@@ -146,6 +150,162 @@ TEST(RefineHit, CornerOrderDoesNotChangeThePlanePoint) {
       }
       expectSame(refineHitAt(ray, rendererHit(1.0f), t, b), refineHit(s, ray, rendererHit(1.0f)));
     }
+  }
+}
+
+// The plane point and face normal as computed before the per-thread memo
+// of the last triangle (common/surface.cpp): every call from scratch.
+bool referencePlanePoint(const Scene& scene, uint32_t tri, const Ray& ray, double* t, glm::dvec2* b) {
+  const glm::uvec3 v = scene.triangles[tri];
+  std::array<glm::dvec3, 3> corner = {glm::dvec3(scene.positions[v.x]), glm::dvec3(scene.positions[v.y]),
+                                      glm::dvec3(scene.positions[v.z])};
+  auto less = [&](int i, int j) {
+    const glm::dvec3 &p = corner[size_t(i)], &q = corner[size_t(j)];
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    return p.z < q.z;
+  };
+  std::array<int, 3> order = {0, 1, 2};
+  if (less(order[1], order[0])) std::swap(order[0], order[1]);
+  if (less(order[2], order[1])) std::swap(order[1], order[2]);
+  if (less(order[1], order[0])) std::swap(order[0], order[1]);
+  const glm::dvec3 &a = corner[size_t(order[0])], &bb = corner[size_t(order[1])],
+                   &c = corner[size_t(order[2])];
+  const glm::dvec3 e1 = bb - a, e2 = c - a;
+  const glm::dvec3 p = glm::cross(ray.direction, e2);
+  const double det = glm::dot(e1, p);
+  if (!(std::abs(det) > 0.0)) return false;
+  const double inv = 1.0 / det;
+  const glm::dvec3 s = ray.origin - a;
+  const double u = glm::dot(s, p) * inv;
+  const glm::dvec3 q = glm::cross(s, e1);
+  const double w = glm::dot(ray.direction, q) * inv;
+  *t = glm::dot(e2, q) * inv;
+  std::array<double, 3> weight{};
+  weight[size_t(order[0])] = 1.0 - u - w;
+  weight[size_t(order[1])] = u;
+  weight[size_t(order[2])] = w;
+  *b = glm::dvec2(weight[1], weight[2]);
+  return std::isfinite(*t) && std::isfinite(u) && std::isfinite(w);
+}
+
+glm::dvec3 referenceFaceNormal(const Scene& scene, uint32_t tri) {
+  const glm::uvec3 v = scene.triangles[tri];
+  const glm::dvec3 p0(scene.positions[v.x]), p1(scene.positions[v.y]), p2(scene.positions[v.z]);
+  const glm::dvec3 n = glm::cross(p1 - p0, p2 - p0);
+  const double length = glm::length(n);
+  return length > 0.0 ? n / length : glm::dvec3(0.0, 0.0, 1.0);
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Both surface.cpp functions against the from-scratch reference, bit for
+// bit, for one ray and triangle of `s` (whatever the memo holds).
+void expectMatchesReference(const Scene& s, uint32_t tri, const Ray& ray, const std::string& where) {
+  double t = 0.0, tr = 0.0;
+  glm::dvec2 b(0.0), br(0.0);
+  const bool ok = intersectTrianglePlane(s, 0, tri, ray, &t, &b);
+  ASSERT_EQ(ok, referencePlanePoint(s, tri, ray, &tr, &br)) << where;
+  if (ok) {
+    EXPECT_TRUE(sameBits(t, tr) && sameBits(b.x, br.x) && sameBits(b.y, br.y)) << where;
+  }
+  SampleHit h;
+  h.instance = 0;
+  h.triangle = tri;
+  h.b1 = 0.2f;
+  h.b2 = 0.3f;
+  const glm::dvec3 n = makeSurfacePoint(s, h).geometricNormal, nr = referenceFaceNormal(s, tri);
+  EXPECT_TRUE(sameBits(n.x, nr.x) && sameBits(n.y, nr.y) && sameBits(n.z, nr.z)) << where;
+}
+
+// The last triangle's corners, edges and normal are remembered per thread
+// (common/surface.cpp): repeated, alternating and edited triangles, and
+// another scene with the same (instance, triangle), give exactly what a
+// computation from scratch gives. Edits in place (rebasing, a test moving
+// a vertex) must never be answered from the memo.
+TEST(RefineHit, TheLastTriangleMemoNeverChangesResults) {
+  uint32_t state = 99u;
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / float(1u << 24) * 4.0f - 2.0f;
+  };
+  Scene s = triangleScene();
+  s.positions.clear();
+  s.triangles.clear();
+  for (uint32_t i = 0; i < 6; ++i) {
+    for (int k = 0; k < 3; ++k) s.positions.push_back({next(), next(), next()});
+    s.triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
+  }
+  s.positions[15] = s.positions[16] = s.positions[17];  // triangle 5 is degenerate
+  s.instances[0].vertexCount = uint32_t(s.positions.size());
+  s.instances[0].triangleCount = uint32_t(s.triangles.size());
+  const uint32_t sequence[] = {0, 0, 0, 1, 0, 1, 2, 2, 5, 5, 3, 4, 3, 0};
+  for (int r = 0; r < 20; ++r) {
+    const Ray ray = rayThrough({next() * 5, next() * 5, 9.0 + next()}, {next(), next(), next()});
+    for (const uint32_t tri : sequence)
+      expectMatchesReference(s, tri, ray, "sequence, triangle " + std::to_string(tri));
+  }
+  // The same triangle edited in place, then one of its corners set back.
+  const Ray ray = rayThrough({0.5, 0.25, 7.0}, {0.1, 0.2, 0.0});
+  expectMatchesReference(s, 1, ray, "before the edit");
+  const glm::vec3 saved = s.positions[4];
+  s.positions[4] += glm::vec3(0.0f, 0.0f, 0.5f);
+  expectMatchesReference(s, 1, ray, "edited");
+  s.positions[4].x = -0.0f;
+  expectMatchesReference(s, 1, ray, "-0");
+  s.positions[4].x = 0.0f;
+  expectMatchesReference(s, 1, ray, "+0");
+  s.positions[4] = saved;
+  expectMatchesReference(s, 1, ray, "restored");
+  // Another scene, same (instance, triangle), other corners.
+  Scene other = s;
+  for (glm::vec3& p : other.positions) p = glm::vec3(p.y, p.z, p.x) * 3.0f;
+  expectMatchesReference(s, 2, ray, "first scene");
+  expectMatchesReference(other, 2, ray, "second scene");
+  expectMatchesReference(s, 2, ray, "first scene again");
+}
+
+void expectSameSurfacePoint(const SurfacePoint& a, const SurfacePoint& b, const std::string& where) {
+  EXPECT_EQ(a.instance, b.instance) << where;
+  EXPECT_EQ(a.triangle, b.triangle) << where;
+  EXPECT_EQ(a.material, b.material) << where;
+  EXPECT_TRUE(std::memcmp(&a.b1, &b.b1, sizeof a.b1) == 0 && std::memcmp(&a.b2, &b.b2, sizeof a.b2) == 0)
+      << where;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(sameBits(a.position[k], b.position[k])) << where;
+    EXPECT_TRUE(sameBits(a.geometricNormal[k], b.geometricNormal[k])) << where;
+    EXPECT_TRUE(sameBits(a.shadingNormal[k], b.shadingNormal[k])) << where;
+  }
+  EXPECT_TRUE(std::memcmp(&a.uv, &b.uv, sizeof a.uv) == 0) << where;
+  EXPECT_TRUE(std::memcmp(&a.color, &b.color, sizeof a.color) == 0) << where;
+}
+
+// surfacePointOnRay is makeSurfacePoint(refineHit(...)) in one call: the
+// same bits inside the triangle, outside it (clamped), with the plane
+// behind the ray (the hit kept) and for a ray in the plane (no
+// intersection).
+TEST(RefineHit, SurfacePointOnRayIsMakeSurfacePointOfTheRefinedHit) {
+  Scene s = triangleScene();
+  s.instances[0].normals = NormalSource::Authored;
+  s.normals = {{0.1f, 0.2f, 1.0f}, {-0.3f, 0.0f, 0.9f}, {0.0f, 0.5f, 0.8f}};
+  s.instances[0].hasColors = true;
+  s.colors = {{1.0f, 0.5f, 0.25f, 1.0f}, {0.0f, 1.0f, 0.5f, 0.5f}, {0.3f, 0.3f, 1.0f, 1.0f}};
+  uint32_t state = 7u;
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return double(state >> 8) / double(1u << 24) * 3.0 - 1.5;
+  };
+  std::vector<Ray> rays;
+  for (int i = 0; i < 300; ++i)
+    rays.push_back(rayThrough({next(), next(), 3.0 + next()}, {next(), next(), 0.0}));
+  rays.push_back(rayThrough({0, 0, -2}, {0, 0, -3}));     // plane behind the ray
+  rays.push_back(rayThrough({-5, 0.1, 0}, {5, 0.1, 0}));  // in the plane
+  for (size_t i = 0; i < rays.size(); ++i) {
+    SampleHit hit = rendererHit(1.5f);
+    hit.b1 = float(0.5 + 0.3 * next());
+    hit.b2 = float(0.25 + 0.2 * next());
+    expectSameSurfacePoint(surfacePointOnRay(s, rays[i], hit),
+                           makeSurfacePoint(s, refineHit(s, rays[i], hit)), "ray " + std::to_string(i));
   }
 }
 
