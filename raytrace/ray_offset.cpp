@@ -44,7 +44,13 @@ double floatSpacing(double x) {
   const int exponent = int((bits >> 23) & 0xffu);
   if (exponent == 0xff) return kInf;
   if (exponent == 0) return double(FLT_MIN);
-  return std::ldexp(1.0, exponent - 127 - 23);
+  // 2^(exponent − 150), a normal double for every exponent 1…254: its
+  // bits directly (the same value std::ldexp(1.0, exponent − 150) gives,
+  // without the library call).
+  const uint64_t doubleBits = uint64_t(exponent - 150 + 1023) << 52;
+  double spacing;
+  std::memcpy(&spacing, &doubleBits, sizeof spacing);
+  return spacing;
 }
 
 // x rounded to a float on the side `direction` points to, never to a
@@ -138,6 +144,44 @@ double sideSign(const Vertices& p, const glm::dvec3& side) {
   return glm::dot(side, glm::cross(p[1] - p[0], p[2] - p[0])) >= 0.0 ? 1.0 : -1.0;
 }
 
+// What errorBoundRayOrigin derives from the triangle alone: its vertices
+// as Embree reads them, their normal N = cross(p1 − p0, p2 − p0) and |N|.
+// Consecutive secondary rays mostly leave the triangle the previous one
+// left, so each thread remembers the last triangle's, keyed by the bits of
+// its float vertices (a memo hit is exactly what would be recomputed).
+// A plain aggregate: thread storage starts zero-filled (valid false)
+// without a per-access initialization check.
+struct TriangleMemo {
+  bool valid;
+  uint32_t key[9];
+  Vertices p;
+  glm::dvec3 normal;
+  double normalLength;
+};
+thread_local TriangleMemo triangleMemo;
+
+inline uint32_t bitsOf(float f) {
+  uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+const TriangleMemo& triangleData(const FloatTriangle& t) {
+  TriangleMemo& m = triangleMemo;
+  uint32_t differ = m.valid ? 0u : 1u;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) differ |= m.key[3 * i + k] ^ bitsOf(t[size_t(i)][k]);
+  if (differ != 0) {
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) m.key[3 * i + k] = bitsOf(t[size_t(i)][k]);
+    m.p = verticesOf(t);
+    m.normal = glm::cross(m.p[1] - m.p[0], m.p[2] - m.p[0]);
+    m.normalLength = glm::length(m.normal);
+    m.valid = true;
+  }
+  return m;
+}
+
 }  // namespace
 
 EmbreeSideMargin embreeSideMargin(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side) {
@@ -174,11 +218,12 @@ bool denominatorCertified(const FloatTriangle& triangle, const glm::vec3& o, con
 
 glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
                               const glm::dvec3& side) {
-  const Vertices p = verticesOf(triangle);
-  const double normalLength = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  const TriangleMemo& data = triangleData(triangle);
+  const Vertices& p = data.p;
+  const double normalLength = data.normalLength;
   if (!(normalLength > 0.0) || !std::isfinite(normalLength))
     return floatUlpsRayOrigin(glm::vec3(position), glm::vec3(side));  // no plane to leave
-  const double s = sideSign(p, side);
+  const double s = glm::dot(side, data.normal) >= 0.0 ? 1.0 : -1.0;   // sideSign(p, side)
 
   // 1. How far the double hit point may lie off the plane (header).
   const double b0 = 1.0 - double(b1) - double(b2);

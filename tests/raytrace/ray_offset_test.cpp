@@ -5,9 +5,12 @@
 // and Embree does not hit the triangle again from it.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <random>
+#include <vector>
 
 #include "common/surface.h"
 #include "raytrace/ray_caster.h"
@@ -114,6 +117,44 @@ TEST(ErrorBoundOffset, OriginLiesStrictlyOnTheLeavingSide) {
   // For the record (the RTG offset is large enough to land on the right
   // side of these well-shaped triangles nearly always).
   std::printf("float-ulps origins not strictly on the leaving side: %d of %d\n", floatUlpsWrong, total);
+}
+
+// errorBoundRayOrigin remembers the last triangle's vertices and normal
+// per thread (raytrace/ray_offset.cpp). The origin for a sample must not
+// depend on which triangle came before: the same bits after the same
+// triangle (memo hit), after another one (miss) and after a triangle that
+// differs from it in one vertex bit only, and every origin passes the
+// check leavesWithoutRehit makes without the memo.
+TEST(ErrorBoundOffset, SameOriginWhicheverTriangleCameBefore) {
+  std::mt19937 rng(21);
+  std::vector<Sample> samples;
+  for (double magnitude : {1e-2, 1.0, 1e3, 1e6})
+    for (int i = 0; i < 6; ++i) samples.push_back(randomSample(rng, magnitude, 0.5 * magnitude));
+  // Same triangle as sample 0, one vertex one float step away.
+  Sample nudged = samples[0];
+  nudged.triangle[2].y = std::nextafter(nudged.triangle[2].y, INFINITY);
+  samples.push_back(nudged);
+  auto origin = [](const Sample& s) {
+    return errorBoundRayOrigin(s.triangle, s.position, s.b1, s.b2, s.side);
+  };
+  auto bits = [](const glm::vec3& o) {
+    uint32_t b[3];
+    std::memcpy(b, &o, sizeof b);
+    return std::array<uint32_t, 3>{b[0], b[1], b[2]};
+  };
+  std::vector<std::array<uint32_t, 3>> first;
+  for (const Sample& s : samples) {
+    const glm::vec3 o = origin(s);
+    EXPECT_TRUE(leavesWithoutRehit(s.triangle, o, s.side));
+    first.push_back(bits(o));
+  }
+  for (size_t i = 0; i < samples.size(); ++i) {
+    EXPECT_EQ(bits(origin(samples[i])), first[i]) << "again, sample " << i;  // after itself
+    for (size_t j : {size_t(0), samples.size() - 1, (i + 5) % samples.size()}) {
+      origin(samples[j]);
+      EXPECT_EQ(bits(origin(samples[i])), first[i]) << "sample " << i << " after " << j;
+    }
+  }
 }
 
 // A nearly level floor far out along x: the RTG offset moves x by
