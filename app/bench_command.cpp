@@ -194,9 +194,20 @@ void appendPeersCsv(const std::string& path, const BenchResult& ours, const Spre
   if (!f) throw InputError(path, "file", "cannot append");
 }
 
+// The folder an output file goes into is made before the frames, so a run
+// never ends in "cannot write" after minutes of work.
+void makeParentFolder(const std::string& path) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code error;
+  if (!parent.empty()) std::filesystem::create_directories(parent, error);
+  if (error) throw InputError(path, "folder", "cannot create " + parent.string() + ": " + error.message());
+}
+
 int runBenchCommand(BenchCommandOptions& opt) {
   opt.settings.finish();
   if (opt.frames < 1) throw InputError("command line", "--frames", "must be at least 1");
+  for (const std::string* path : {&opt.csvPath, &opt.peersCsvPath, &opt.jsonPath})
+    if (!path->empty()) makeParentFolder(*path);
   std::unique_ptr<tbb::global_control> threads;
   if (opt.settings.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
