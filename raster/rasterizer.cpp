@@ -134,7 +134,27 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
                               options.keepSamples ? &deepCounts[t] : nullptr, hits};
     renderer.render(tiles.rect(tile), bins, &target, outputs, counters.local());
   });
-  out.timings.emplace_back("raster.tiles", secondsSince(start));
+  const double tileSeconds = secondsSince(start);
+  out.timings.emplace_back("raster.tiles", tileSeconds);
+  {
+    // The tile loop's wall time split among its passes in proportion to
+    // their thread-seconds, so the parts add up to raster.tiles at any
+    // thread count (as the ray caster splits primary and shade).
+    ThreadCounters sum;
+    for (const ThreadCounters& c : counters) sum += c;
+    const double busy = sum.depthSeconds + sum.shadeSeconds + sum.transparencySeconds + sum.resolveSeconds;
+    const double scale = busy > 0.0 ? tileSeconds / busy : 0.0;
+    out.timings.emplace_back("raster.tiles.depth", sum.depthSeconds * scale);
+    out.timings.emplace_back("raster.tiles.shade", sum.shadeSeconds * scale);
+    // Without BLEND materials pass 2 is only the compositing of opaque
+    // samples: counted with the resolve.
+    double resolve = sum.resolveSeconds;
+    if (analysis.transparency)
+      out.timings.emplace_back("raster.tiles.transparency", sum.transparencySeconds * scale);
+    else
+      resolve += sum.transparencySeconds;
+    out.timings.emplace_back("raster.tiles.resolve", resolve * scale);
+  }
 
   if (options.keepSamples) {
     out.samples = assembleDeepImage(tiles, deep, deepCounts);

@@ -3,6 +3,7 @@
 // triangles with.
 #include "raster/tile_renderer.h"
 
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -20,6 +21,10 @@ ThreadCounters& ThreadCounters::operator+=(const ThreadCounters& other) {
   fragmentsTransparent += other.fragmentsTransparent;
   shadedSamples += other.shadedSamples;
   peelPasses += other.peelPasses;
+  depthSeconds += other.depthSeconds;
+  shadeSeconds += other.shadeSeconds;
+  transparencySeconds += other.transparencySeconds;
+  resolveSeconds += other.resolveSeconds;
   return *this;
 }
 
@@ -54,17 +59,29 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
                            .add("blend_binned", std::to_string(bins.blend ? bins.blend->size() : size_t(0))));
   }
 
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double>(b - a).count();
+  };
+  const Clock::time_point t0 = Clock::now();
   opaquePass(rect, bins.opaque, trace, target, n);
+  const Clock::time_point t1 = Clock::now();
   TileSamples samples = shadeVisible(index, *target, trace, out.hits != nullptr, n);
+  const Clock::time_point t2 = Clock::now();
   std::vector<BlendLayer> layers;
   if (bins.blend && !bins.blend->empty()) layers = transparencyPass(index, *bins.blend, *target, n);
   const std::vector<glm::vec4> opaqueColor = compositeLayers(layers, &samples);
   if (traced) traceLayersAndFinal(index, trace, layers, samples);
+  const Clock::time_point t3 = Clock::now();
 
   resolveTile(rect, grid_.spp, centre_, samples, out.image);
   if (out.hits) copyHits(index, samples, *target, out.hits);
   if (out.deep)
     appendDeepSamples(index, layers, *target, opaqueColor.empty() ? samples.color : opaqueColor, out);
+  n.depthSeconds += seconds(t0, t1);
+  n.shadeSeconds += seconds(t1, t2);
+  n.transparencySeconds += seconds(t2, t3);
+  n.resolveSeconds += seconds(t3, Clock::now());
 }
 
 SampleHit TileRenderer::interpolatedHit(const TriangleSetup& t, const glm::dvec2& pos) const {

@@ -49,6 +49,12 @@ struct ThreadCounters {
   uint64_t fragmentsTransparent = 0;
   uint64_t shadedSamples = 0;
   uint64_t peelPasses = 0;
+  // Thread-seconds per pass of the tiles (three clock reads per tile):
+  // rasterizer.cpp splits the tile loop's wall time among them.
+  double depthSeconds = 0.0;         // pass 1: coverage, depth test and write
+  double shadeSeconds = 0.0;         // deferred shading of the visible samples
+  double transparencySeconds = 0.0;  // pass 2 and compositing
+  double resolveSeconds = 0.0;       // resolve, hits, deep samples
 
   ThreadCounters& operator+=(const ThreadCounters& other);
 };

@@ -66,6 +66,24 @@ TEST(Bench, RasterReportsStagesAndNoBvh) {
   bool tiles = false;
   for (const StageTime& s : r.stages) tiles = tiles || (s.name == "raster.tiles" && s.seconds.count == 2);
   EXPECT_TRUE(tiles);
+  // The tile loop's passes split its wall time: in one frame they add up.
+  BenchRequest one;
+  one.scenePath = kCornell;
+  one.settings = stability::renderSettingsFrom({"--size", "64", "48", "--threads", "2"});
+  one.frames = 1;
+  one.warmup = 0;
+  const BenchResult single = runBench(one);
+  double whole = -1.0, parts = 0.0;
+  int partCount = 0;
+  for (const StageTime& s : single.stages) {
+    if (s.name == "raster.tiles") whole = s.seconds.median;
+    if (s.name.rfind("raster.tiles.", 0) == 0) {
+      parts += s.seconds.median;
+      ++partCount;
+    }
+  }
+  EXPECT_EQ(partCount, 3);  // depth, shade, resolve (no BLEND material)
+  EXPECT_NEAR(parts, whole, 1e-9 * std::max(1.0, whole));
   EXPECT_LE(r.frame.min, r.frame.median);
   EXPECT_LE(r.frame.median, r.frame.max);
 
