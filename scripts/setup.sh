@@ -12,8 +12,6 @@ packages=(
   libtbb-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   chromium  # the real-browser report test (headless), which CI must run, not skip
   libosmesa6-dev embree-tools  # performance peers of `rastray bench --peers`: Mesa llvmpipe, Embree's viewer
-  clang libfuzzer-14-dev libclang-rt-14-dev  # fuzz targets and the thread sanitizer (scripts/fuzz.sh)
-  libcpp-httplib-dev  # `rastray serve`
   assimp-testmodels  # real-world glTF models: the CAD-like 2CylinderEngine.glb that `rastray bench` measures
 )
 
