@@ -335,6 +335,13 @@ void writePng(const std::string& path, const FlatImage& image) {
                   [&](OIIO::ImageOutput& out) { return out.write_image(OIIO::TypeUInt8, rgba.data()); });
 }
 
+// OIIO's OpenEXR writer stamps the current time as DateTime unless the
+// spec sets one; an empty string makes it write none, so the same render
+// gives the same bytes (issue 13: no varying metadata in headers).
+namespace {
+void omitTimestamp(OIIO::ImageSpec& spec) { spec.attribute("DateTime", ""); }
+}  // namespace
+
 void writeExr(const std::string& path, const FlatImage& image, ColorPrecision precision) {
   checkFlat(image);
   const OIIO::TypeDesc colorType = precision == ColorPrecision::Float ? OIIO::TypeFloat : OIIO::TypeHalf;
@@ -346,6 +353,7 @@ void writeExr(const std::string& path, const FlatImage& image, ColorPrecision pr
   spec.z_channel = 4;
   // Lossless (not pxr24 or dwa), so Z and the IDs survive bit for bit.
   spec.attribute("compression", "zip");
+  omitTimestamp(spec);
 
   // The file's native layout: per pixel, each channel in its own format,
   // packed. OIIO converts colour to half (round to nearest even) and copies
@@ -388,6 +396,7 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
   spec.z_channel = 4;
   spec.deep = true;
   spec.attribute("compression", "zips");  // lossless; deep files allow none, rle, zips
+  omitTimestamp(spec);
 
   OIIO::DeepData deep(spec);
   std::vector<unsigned int> counts(pixels);

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <OpenImageIO/deepdata.h>
@@ -31,8 +33,8 @@ class ImageTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("rastray_image_test_" + std::to_string(::getpid()) + "_" + info->name());
+    dir_ =
+        fs::temp_directory_path() / ("rastray_image_test_" + std::to_string(::getpid()) + "_" + info->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -70,8 +72,7 @@ std::map<std::string, std::string> channelFormats(const std::string& file) {
 
 // Writes a flat float EXR with the given channels directly through OIIO, as
 // another renderer might. `values` holds one row of nchannels per pixel.
-void writeForeignExr(const std::string& file, const OIIO::ImageSpec& spec,
-                     const std::vector<float>& values) {
+void writeForeignExr(const std::string& file, const OIIO::ImageSpec& spec, const std::vector<float>& values) {
   auto out = OIIO::ImageOutput::create(file);
   ASSERT_TRUE(out) << OIIO::geterror();
   ASSERT_TRUE(out->open(file, spec)) << out->geterror();
@@ -279,8 +280,7 @@ TEST_F(ImageTest, ReadExrTakesIntegralFloatIds) {
 
 TEST_F(ImageTest, ReadExrRejectsFractionalIds) {
   const std::string file = path("badids.exr");
-  writeForeignExr(file, floatSpec(2, 1, {"R", "G", "B", "id.instance"}),
-                  {0, 0, 0, 1.0f, 0, 0, 0, 2.5f});
+  writeForeignExr(file, floatSpec(2, 1, {"R", "G", "B", "id.instance"}), {0, 0, 0, 1.0f, 0, 0, 0, 2.5f});
   try {
     readExr(file);
     FAIL() << "no InputError";
@@ -353,6 +353,28 @@ DeepImage testDeepImage() {
   }
   image.samples.back().depth = kInf;
   return image;
+}
+
+// Issue 13: the same image gives the same bytes. OIIO stamps DateTime into
+// EXR headers unless told otherwise; neither flat nor deep files carry it,
+// and two writes a second apart are identical.
+TEST_F(ImageTest, ExrHeadersCarryNoTimestamp) {
+  const std::string flat = path("flat.exr"), deep = path("deep.exr");
+  writeExr(flat, testImage(), ColorPrecision::Half);
+  writeDeepExr(deep, testDeepImage());
+  for (const std::string& file : {flat, deep}) {
+    auto in = OIIO::ImageInput::open(file);
+    ASSERT_TRUE(in) << file;
+    EXPECT_EQ(in->spec().find_attribute("DateTime"), nullptr) << file;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));  // DateTime has whole seconds
+  const std::string again = path("again.exr");
+  writeExr(again, testImage(), ColorPrecision::Half);
+  const auto bytes = [](const std::string& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(bytes(flat), bytes(again));
 }
 
 TEST_F(ImageTest, DeepExrRoundTripsEverySampleExactly) {
