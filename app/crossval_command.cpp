@@ -143,7 +143,12 @@ int runCrossval(CrossvalOptions& opt) {
              {"color", colorJson(r.hybridVsRayColor, r.hybridWhereAgree)}}},
            {"seconds",
             {{"raster", r.raster.seconds}, {"raytrace", r.raytrace.seconds}, {"hybrid", r.hybrid.seconds}}}});
-    std::cout << nlohmann::json{{"scenes", j}, {"failures", failures}}.dump(2) << "\n";
+    std::cout << nlohmann::json{{"schema", "rastray.crossval"},
+                                {"version", 1},
+                                {"scenes", j},
+                                {"failures", failures}}
+                     .dump(2)
+              << "\n";
   } else {
     // The scene column is as wide as the longest file name.
     int nameWidth = 5;

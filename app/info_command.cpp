@@ -64,6 +64,8 @@ int runInfo(const InfoOptions& opt) {
 
   if (opt.json) {
     nlohmann::json j;
+    j["schema"] = "rastray.info";
+    j["version"] = 1;
     j["scene"] = scene.path;
     j["sceneIndex"] = scene.stats.sceneIndex;
     j["nodes"] = scene.stats.nodes;

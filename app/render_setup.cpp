@@ -415,6 +415,8 @@ RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
 
 nlohmann::json renderReportJson(const Scene& scene, const RenderSettings& s, const RenderRun& run) {
   nlohmann::json j;
+  j["schema"] = "rastray.render";
+  j["version"] = 1;
   j["scene"] = scene.path;
   j["renderer"] = toString(s.renderer);
   j["width"] = run.camera.width;

@@ -151,7 +151,8 @@ nlohmann::json tableJson(const std::vector<CaseResult>& results, bool quick) {
                      {"rows", rows}});
   }
   const std::vector<std::string> failed = failures(results);
-  return {{"quick", quick}, {"passed", failed.empty()}, {"failures", failed}, {"cases", cases}};
+  return {{"schema", "rastray.stability"}, {"version", 1},       {"quick", quick},
+          {"passed", failed.empty()},      {"failures", failed}, {"cases", cases}};
 }
 
 void writeStabilityReport(const std::string& dir, const std::vector<CaseResult>& results,

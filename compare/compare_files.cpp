@@ -221,6 +221,8 @@ nlohmann::json toJson(const CompareResult& r, const Thresholds& t,
                       const std::vector<std::string>& violations) {
   const VisibilityReport& v = r.visibility;
   nlohmann::json j;
+  j["schema"] = "rastray.compare";
+  j["version"] = 1;
   j["a"] = r.pathA;
   j["b"] = r.pathB;
   j["width"] = v.width;
