@@ -1,6 +1,8 @@
 #include "common/gltf/check.h"
 
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <set>
 
 #include "common/error.h"
@@ -117,6 +119,19 @@ class Checker {
     if (!v->is_number()) fail(element, std::string("\"") + key + "\" must be a number, got " + typeName(*v));
     const double d = v->get<double>();
     if (!std::isfinite(d)) fail(element, std::string("\"") + key + "\" is not finite");
+    return d;
+  }
+
+  // A number the scene stores as a float (material factors, light values):
+  // beyond float range it would turn into infinity unnoticed.
+  double floatNumber(const json& obj, const char* key, const std::string& element, bool required,
+                     double fallback = 0.0) const {
+    const double d = number(obj, key, element, required, fallback);
+    if (std::abs(d) > double(std::numeric_limits<float>::max())) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", d);
+      fail(element, std::string("\"") + key + "\" " + value + " is out of float range");
+    }
     return d;
   }
 
@@ -423,8 +438,8 @@ void checkMaterials(const Checker& c, const json& doc) {
         c.numberArray(*pbr, "baseColorFactor", pe, 4, 4);
         c.textureInfo(*pbr, "baseColorTexture", pe);
         c.textureInfo(*pbr, "metallicRoughnessTexture", pe);
-        c.number(*pbr, "metallicFactor", pe, false);
-        c.number(*pbr, "roughnessFactor", pe, false);
+        c.floatNumber(*pbr, "metallicFactor", pe, false);
+        c.floatNumber(*pbr, "roughnessFactor", pe, false);
       }
       c.textureInfo(m, "normalTexture", e);
       c.textureInfo(m, "occlusionTexture", e);
@@ -433,23 +448,23 @@ void checkMaterials(const Checker& c, const json& doc) {
       const std::string mode = c.string(m, "alphaMode", e, false);
       if (c.member(m, "alphaMode") && mode != "OPAQUE" && mode != "MASK" && mode != "BLEND")
         c.fail(e, "\"alphaMode\" \"" + mode + "\" is not OPAQUE, MASK or BLEND");
-      c.number(m, "alphaCutoff", e, false);
+      c.floatNumber(m, "alphaCutoff", e, false);
       c.boolean(m, "doubleSided", e);
       if (const json* ext = c.member(m, "extensions")) {
         c.object(*ext, e + " extensions");
         if (const json* t = c.member(*ext, "KHR_materials_transmission")) {
           const std::string te = e + " KHR_materials_transmission";
           c.object(*t, te);
-          c.number(*t, "transmissionFactor", te, false);
+          c.floatNumber(*t, "transmissionFactor", te, false);
           c.textureInfo(*t, "transmissionTexture", te);
         }
         if (const json* t = c.member(*ext, "KHR_materials_ior")) {
           c.object(*t, e + " KHR_materials_ior");
-          c.number(*t, "ior", e + " KHR_materials_ior", false);
+          c.floatNumber(*t, "ior", e + " KHR_materials_ior", false);
         }
         if (const json* t = c.member(*ext, "KHR_materials_emissive_strength")) {
           c.object(*t, e + " KHR_materials_emissive_strength");
-          c.number(*t, "emissiveStrength", e + " KHR_materials_emissive_strength", false);
+          c.floatNumber(*t, "emissiveStrength", e + " KHR_materials_emissive_strength", false);
         }
       }
     }
@@ -536,15 +551,15 @@ size_t checkLights(const Checker& c, const json& doc) {
           if (type != "point" && type != "spot" && type != "directional")
             c.fail(e, "\"type\" \"" + type + "\" is not point, spot or directional");
           c.numberArray(l, "color", e, 3, 3);
-          if (c.number(l, "intensity", e, false, 1.0) < 0.0) c.fail(e, "\"intensity\" must be >= 0");
-          if (c.member(l, "range") && !(c.number(l, "range", e, false) > 0.0))
+          if (c.floatNumber(l, "intensity", e, false, 1.0) < 0.0) c.fail(e, "\"intensity\" must be >= 0");
+          if (c.member(l, "range") && !(c.floatNumber(l, "range", e, false) > 0.0))
             c.fail(e, "\"range\" must be > 0");
           if (type == "spot") {
             const json* spot = c.member(l, "spot");
             if (!spot) c.fail(e, "\"spot\" is missing");
             c.object(*spot, e + " spot");
-            const double inner = c.number(*spot, "innerConeAngle", e + " spot", false, 0.0);
-            const double outer = c.number(*spot, "outerConeAngle", e + " spot", false, kPi / 4);
+            const double inner = c.floatNumber(*spot, "innerConeAngle", e + " spot", false, 0.0);
+            const double outer = c.floatNumber(*spot, "outerConeAngle", e + " spot", false, kPi / 4);
             if (!(inner >= 0.0 && inner < outer && outer <= kPi / 2))
               c.fail(e + " spot", "cone angles must satisfy 0 <= inner < outer <= pi/2");
           }

@@ -120,6 +120,9 @@ const BadInput kBadInputs[] = {
     {"camera-zfar-below-znear.gltf", "camera 0 perspective: \"zfar\""},
     {"camera-node-singular.gltf", "node 1: the camera's world matrix is singular"},
     {"light-negative-intensity.gltf", "light 0: \"intensity\""},
+    {"light-intensity-overflow.gltf", "light 0: \"intensity\" 1e+300 is out of float range"},
+    {"material-alphacutoff-overflow.gltf", "material 0: \"alphaCutoff\" 1e+39 is out of float range"},
+    {"material-ior-overflow.gltf", "material 0 KHR_materials_ior: \"ior\" 3.5e+38 is out of float range"},
     {"light-index-missing.gltf", "node 0 KHR_lights_punctual: \"light\" refers to light 0"},
     // References to elements that do not exist.
     {"mesh-index-missing.gltf", "node 0: \"mesh\" refers to mesh 5"},

@@ -411,6 +411,18 @@ def malformed():
     # A string from the file that would break the message into two lines.
     cam = {"type": "perspective\nsecond line", "perspective": {"yfov": 0.8, "znear": 0.1}}
     files["camera-type-newline.gltf"] = text(quad_doc(cameras=[cam]))
+    # Finite in JSON (a double) but beyond float range, where the scene
+    # stores it: would silently become infinity.
+    files["light-intensity-overflow.gltf"] = text(quad_doc(
+        extensionsUsed=["KHR_lights_punctual"],
+        extensions={"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e300}]}}))
+    d = quad_doc(materials=[{"alphaMode": "MASK", "alphaCutoff": 1e39}])
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    files["material-alphacutoff-overflow.gltf"] = text(d)
+    d = quad_doc(materials=[{"extensions": {"KHR_materials_ior": {"ior": 3.5e38}}}],
+                 extensionsUsed=["KHR_materials_ior"])
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    files["material-ior-overflow.gltf"] = text(d)
     files["light-negative-intensity.gltf"] = text(quad_doc(
         extensionsUsed=["KHR_lights_punctual"],
         extensions={"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": -1.0}]}}))
