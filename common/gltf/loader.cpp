@@ -40,8 +40,17 @@ std::string firstLine(const std::string& text) {
 std::string expandNothing(const std::string& path, void*) { return path; }
 
 // Only regular files count as found: tinygltf would take the seek size of
-// a directory (2^63 - 1 on some file systems) as its length.
-bool isRegularFile(const std::string& path, void*) {
+// a directory (2^63 - 1 on some file systems) as its length. And only those
+// beside the glTF file (base/uri, as tinygltf joins them): tinygltf also
+// searches the current directory, where a file of the same name is not the
+// scene's resource.
+struct ResourceFolder {
+  std::string prefix;  // the base directory and a slash
+};
+
+bool isResourceFile(const std::string& path, void* user) {
+  const ResourceFolder& folder = *static_cast<const ResourceFolder*>(user);
+  if (path.compare(0, folder.prefix.size(), folder.prefix) != 0) return false;
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
 }
@@ -50,13 +59,15 @@ bool isRegularFile(const std::string& path, void*) {
 // is sound by now, so its remaining failures are about resources: missing
 // files, bad data URIs, undecodable images.
 void loadResources(const GltfDocument& d, tinygltf::Model& model) {
-  tinygltf::TinyGLTF loader;
-  tinygltf::FsCallbacks fs{&isRegularFile, &expandNothing, &tinygltf::ReadWholeFile,
-                           &tinygltf::WriteWholeFile, nullptr};
-  loader.SetFsCallbacks(fs);
-  std::string err, warn;
   const std::string& path = d.context.file;
   const std::string baseDir = std::filesystem::path(path).parent_path().string();
+  ResourceFolder folder{(baseDir.empty() ? std::string(".") : baseDir) +
+                        (baseDir.empty() || baseDir.back() != '/' ? "/" : "")};
+  tinygltf::TinyGLTF loader;
+  tinygltf::FsCallbacks fs{&isResourceFile, &expandNothing, &tinygltf::ReadWholeFile,
+                           &tinygltf::WriteWholeFile, &folder};
+  loader.SetFsCallbacks(fs);
+  std::string err, warn;
   if (d.bytes.size() > UINT32_MAX) throw InputError(path, "", "file is larger than 4 GiB");
   const bool ok =
       d.context.isGlb

@@ -3,8 +3,11 @@
 // tests/data/malformed/generate.py), checked value by value; and the
 // structured InputError the loader raises for bad input (SPEC §7).
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <glm/glm.hpp>
 #include <limits>
 #include <ostream>
@@ -38,8 +41,7 @@ Scene load(const std::string& name) { return loadScene(kValid + name); }
 // Positions of one instance's vertices, in store order.
 std::vector<glm::vec3> positionsOf(const Scene& s, uint32_t instance) {
   const Instance& in = s.instances.at(instance);
-  return {s.positions.begin() + in.firstVertex,
-          s.positions.begin() + in.firstVertex + in.vertexCount};
+  return {s.positions.begin() + in.firstVertex, s.positions.begin() + in.firstVertex + in.vertexCount};
 }
 
 // Stored triangles of one instance, relative to its first vertex.
@@ -77,8 +79,32 @@ void expectConsistentStore(const Scene& s) {
 
 void expectVec3Near(const glm::dvec3& actual, const glm::dvec3& expected, double tolerance,
                     const std::string& what) {
-  for (int k = 0; k < 3; ++k)
-    EXPECT_NEAR(actual[k], expected[k], tolerance) << what << "[" << k << "]";
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(actual[k], expected[k], tolerance) << what << "[" << k << "]";
+}
+
+// Issue 13: a resource is looked for beside the glTF file only. tinygltf
+// also searches the current directory; a file of the same name there must
+// not stand in for the missing one.
+TEST(SceneLoader, ResourcesResolveOnlyBesideTheFile) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(testing::TempDir()) / "resources-beside-the-file";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "scene");
+  const fs::path gltf = dir / "scene" / "scene.gltf";
+  fs::copy_file(kMalformed + "buffer-missing-file.gltf", gltf);
+  std::ifstream in(gltf);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  const std::string uri = doc.at("buffers").at(0).at("uri");
+  const size_t length = doc.at("buffers").at(0).at("byteLength");
+  // The buffer, of the right length, in the current directory only.
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir);
+  { std::ofstream(uri, std::ios::binary) << std::string(length, '\0'); }
+  EXPECT_THROW(loadScene(gltf.string()), InputError);
+  // Beside the file it is found.
+  fs::copy_file(dir / uri, dir / "scene" / uri);
+  EXPECT_NO_THROW(loadScene(gltf.string()));
+  fs::current_path(cwd);
 }
 
 TEST(SceneLoader, NoMeshesLoadsAsBackgroundOnly) {
@@ -169,8 +195,7 @@ TEST(SceneLoader, DeepNodeChainDoesNotOverflowTheStack) {
   ASSERT_EQ(s.instances.size(), 1u);
   EXPECT_EQ(s.instances[0].node, 9999u);
   // Each of the 10000 nodes moves one unit along +x.
-  EXPECT_EQ(positionsOf(s, 0),
-            (std::vector<glm::vec3>{{10000, 0, 0}, {10001, 0, 0}, {10000, 1, 0}}));
+  EXPECT_EQ(positionsOf(s, 0), (std::vector<glm::vec3>{{10000, 0, 0}, {10001, 0, 0}, {10000, 1, 0}}));
 }
 
 TEST(SceneLoader, MirroredInstanceSwapsWinding) {
@@ -200,8 +225,7 @@ TEST(SceneLoader, StripAndFanTriangleOrder) {
   ASSERT_EQ(s.instances.size(), 2u);
   // Strip, 6 vertices: (i, i+1, i+2), odd i wound (i+1, i, i+2).
   EXPECT_EQ(s.instances[0].mode, 5);
-  EXPECT_EQ(trianglesOf(s, 0),
-            (std::vector<glm::uvec3>{{0, 1, 2}, {2, 1, 3}, {2, 3, 4}, {4, 3, 5}}));
+  EXPECT_EQ(trianglesOf(s, 0), (std::vector<glm::uvec3>{{0, 1, 2}, {2, 1, 3}, {2, 3, 4}, {4, 3, 5}}));
   // Fan, 5 indices: (0, i+1, i+2).
   EXPECT_EQ(s.instances[1].mode, 6);
   EXPECT_EQ(trianglesOf(s, 1), (std::vector<glm::uvec3>{{0, 1, 2}, {0, 2, 3}, {0, 3, 4}}));
@@ -259,8 +283,7 @@ TEST(SceneLoader, DegenerateTrianglesAreCountedAndKept) {
 }
 
 // The loader's error carries file, element and message separately.
-void expectInputError(const std::string& name, const std::string& element,
-                      const std::string& message) {
+void expectInputError(const std::string& name, const std::string& element, const std::string& message) {
   const std::string path = kMalformed + name;
   try {
     loadScene(path);
@@ -273,8 +296,7 @@ void expectInputError(const std::string& name, const std::string& element,
 }
 
 TEST(SceneLoaderErrors, NameTheElement) {
-  expectInputError("index-out-of-range.gltf", "accessor 3",
-                   "index 70000 out of range (24 vertices)");
+  expectInputError("index-out-of-range.gltf", "accessor 3", "index 70000 out of range (24 vertices)");
   expectInputError("node-cycle.gltf", "node 0", "is its own ancestor");
   expectInputError("buffer-missing-file.gltf", "buffer 0", "File not found");
   expectInputError("image-garbage-png.gltf", "image 0", "");
