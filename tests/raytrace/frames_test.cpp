@@ -102,6 +102,33 @@ TEST(Frames, TileSizeDoesNotChangeTheOutput) {
   }
 }
 
+// A primary ray that gathered no layer is shaded without its surface list
+// when no deep output is kept (resolveStoppingHit); with deep output it
+// goes through the list (collectCrossings, composite). Both must give the
+// same flat pixels, Z, IDs and counts, bit for bit: opaque scenes (every
+// ray takes the short path), textured (footprints), vertex colours,
+// secondary and shadow rays (Cornell box), and BLEND scenes (where only
+// rays with no layer in front take it), at 1 and 4 spp.
+TEST(Frames, OpaqueShortPathGivesTheSurfaceListsPixels) {
+  for (const char* name : {"three-triangles.gltf", "vertex-colors.gltf", "textured-plane.gltf",
+                           "cornell-box.gltf", "transparent-layers.gltf", "cyclic-overlap.gltf"}) {
+    const Scene scene = loadScene(scenePath(name));
+    const Camera camera = makeCamera(scene, {}, 37, 29);
+    for (int spp : {1, 4}) {
+      RayOptions options;
+      options.spp = spp;
+      const RenderOutput shortPath = renderWithNewCaster(scene, camera, options);
+      options.keepSamples = true;
+      RenderOutput listPath = renderWithNewCaster(scene, camera, options);
+      ASSERT_TRUE(listPath.hasSamples) << name;
+      EXPECT_GT(listPath.samples.samples.size(), 0u) << name;
+      listPath.hasSamples = false;
+      listPath.samples = DeepImage{};
+      expectIdentical(shortPath, listPath, std::string(name) + ", " + std::to_string(spp) + " spp");
+    }
+  }
+}
+
 double timing(const RenderOutput& out, const std::string& name) {
   for (const auto& [stage, seconds] : out.timings)
     if (stage == name) return seconds;
