@@ -306,8 +306,9 @@ TEST(RenderOptionsCommand, AcceptedWhereTheyApply) {
                                 "--transparency-cutoff", "0.1"},
                            Args{"--renderer", "raster", "--wireframe", "--halo", "--shadow-bias", "1", "1",
                                 "--depth-func", "lequal"}}) {
-    const auto r =
-        runRastray(Args{"render", kScene, "-o", "render-options.png", "--size", "16", "12"} + args);
+    const auto r = runRastray(
+        Args{"render", kScene, "-o", testing::TempDir() + "/render-options.png", "--size", "16", "12"} +
+        args);
     EXPECT_EQ(r.status, 0) << joined(args) << "\n" << r.err;
   }
   const auto r = runRastray({"crossval", kScene, "--size", "16", "12", "--no-packets", "--shadow-map-size",
