@@ -237,6 +237,9 @@ TEST(RefineHit, TheLastTriangleMemoNeverChangesResults) {
     s.triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
   }
   s.positions[15] = s.positions[16] = s.positions[17];  // triangle 5 is degenerate
+  // Every vertex needs its attributes (the base scene has three).
+  s.normals.assign(s.positions.size(), glm::vec3(0, 0, 1));
+  s.texcoords.assign(s.positions.size(), glm::vec2(0.5f, 0.25f));
   s.instances[0].vertexCount = uint32_t(s.positions.size());
   s.instances[0].triangleCount = uint32_t(s.triangles.size());
   const uint32_t sequence[] = {0, 0, 0, 1, 0, 1, 2, 2, 5, 5, 3, 4, 3, 0};
