@@ -358,13 +358,15 @@ FrameRenderer::FrameRenderer(const Scene& scene, const RenderSettings& s, const 
   const auto start = std::chrono::steady_clock::now();
   caster_ = std::make_unique<RayCaster>(scene, analysis_, raster.cull);
   bvhBuildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  caster_->bind(camera_, ray_);
 }
 
 FrameRenderer::~FrameRenderer() = default;
 
 RenderOutput FrameRenderer::frame() {
-  // Binding restarts the ray counters, so each frame reports its own rays.
-  if (caster_) caster_->bind(camera_, ray_);
+  // Each frame reports its own rays (hybrid's shading calls the caster
+  // outside RayCaster::render, which restarts them itself).
+  if (caster_) caster_->resetCounters();
   switch (renderer_) {
     case RendererKind::Raster:
       return renderRaster(scene_, analysis_, camera_, raster_);
