@@ -155,8 +155,12 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         SampleHit hit{t.instance, t.triangle, float(t.viewDepthAt(pos.x, pos.y)), float(b.x), float(b.y)};
         return makeSurfacePoint(scene, refineHit(scene, c.primaryRay(pos), hit));
       };
+      // The alpha test only where a MASK material can use it: without one,
+      // the depth pass runs its lean path (no call per sample).
+      const bool anyMask = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                       [](const Material& m) { return m.alphaMode == AlphaMode::Mask; });
       std::function<bool(const TriangleSetup&, int, int, int)> alphaTest;
-      if (shader)
+      if (shader && anyMask)
         alphaTest = [&](const TriangleSetup& t, int px, int py, int s) {
           const Material& m = scene.materialOf(t.instance);
           if (m.alphaMode != AlphaMode::Mask) return true;
