@@ -75,7 +75,7 @@ BenchResult runBench(const BenchRequest& request) {
 
   std::map<std::string, std::vector<double>> stageSeconds;
   std::vector<std::string> stageOrder;
-  const int count = request.warmup + request.frames;
+  const int count = request.warmup + request.frames * request.rounds;
   for (int i = 0; i < count; ++i) {
     const auto start = std::chrono::steady_clock::now();
     const double cpuStart = processCpuSeconds();
@@ -96,6 +96,9 @@ BenchResult runBench(const BenchRequest& request) {
       r.passesLeftOut = std::move(output.passesLeftOut);
     }
     if (request.progress) request.progress(i + 1, count);
+    const int timed = i + 1 - request.warmup;
+    if (request.afterRound && timed > 0 && timed % request.frames == 0)
+      request.afterRound(timed / request.frames - 1, renderer.camera());
   }
   r.frame = spreadOf(r.frameSeconds);
   r.cpu = spreadOf(r.cpuSeconds);

@@ -29,6 +29,11 @@ struct BenchRequest {
   RenderSettings settings;  // finish() called
   int frames = 10;          // timed frames
   int warmup = 1;           // untimed frames first (caches, page faults, TBB's workers)
+  // Rounds of `frames` timed frames on the one prepared scene; after each,
+  // afterRound (when set) runs with the round's index and the camera — the
+  // peers run there, in alternation with ours (`bench --peers`).
+  int rounds = 1;
+  std::function<void(int round, const Camera& camera)> afterRound;
   // Called after each frame (timed or not) with its index and the count;
   // the command shows progress with it.
   std::function<void(int frame, int count)> progress;
@@ -46,7 +51,7 @@ struct BenchResult {
   uint64_t triangles = 0;
   double loadSeconds = 0.0;          // read, flatten and rebase the glTF
   double bvhBuildSeconds = -1.0;     // negative without a ray caster
-  std::vector<double> frameSeconds;  // the timed frames, in order
+  std::vector<double> frameSeconds;  // the timed frames of every round, in order
   Spread frame;
   // CPU time of all this process's threads per timed frame: less sensitive
   // than wall time to other work on a shared machine (it still counts

@@ -74,49 +74,27 @@ struct PeerRow {
 
 // Rounds alternate ours and the peer, so load on a shared machine hits both
 // alike; ours stays prepared (scene, BVH) across rounds. The rasterizer and
-// hybrid run beside llvmpipe, the ray caster beside Embree's viewer.
-std::vector<PeerRow> runPeerRounds(const BenchCommandOptions& opt, const BenchRequest& request,
-                                   const BenchResult& first, std::vector<double>* ourWall,
-                                   std::vector<double>* ourCpu, bool terminal) {
-  PeerRequest pr;
-  pr.scenePath = request.scenePath;
-  pr.camera = makeCamera(loadSceneForRender(request.scenePath, request.settings),
-                         request.settings.camera.overrides(), first.width, first.height);
-  pr.spp = first.spp;
-  pr.threads = first.threads;
-  pr.frames = opt.frames;
-  pr.workDir = opt.workDir + "/peers";
-  std::vector<PeerRow> rows;
-  for (int round = 0; round < opt.rounds; ++round) {
-    if (round > 0) {
-      BenchRequest again = request;
-      again.warmup = 0;
-      again.progress = nullptr;
-      const BenchResult more = runBench(again);
-      ourWall->insert(ourWall->end(), more.frameSeconds.begin(), more.frameSeconds.end());
-      ourCpu->insert(ourCpu->end(), more.cpuSeconds.begin(), more.cpuSeconds.end());
-    }
-    if (terminal) std::fprintf(stderr, "\rbench: peers, round %d/%d", round + 1, opt.rounds);
-    PeerRun run = first.renderer == RendererKind::Raytrace ? runEmbreeViewer(pr) : runOsmesaPeer(pr);
-    if (rows.empty()) {
-      rows.push_back({run, {}, {}});
-    } else {
-      PeerRun& all = rows.front().run;
-      all.frameMs.insert(all.frameMs.end(), run.frameMs.begin(), run.frameMs.end());
-      all.cpuMs.insert(all.cpuMs.end(), run.cpuMs.begin(), run.cpuMs.end());
-      if (!run.ran && all.ran) all.error = run.error.empty() ? run.skipped : run.error;
-    }
-    if (!run.ran) break;  // absent or failing: once is enough
+// hybrid run beside llvmpipe, the ray caster beside Embree's viewer. Runs
+// the peer after our round `round`; stops once it did not run.
+void runPeerRound(const BenchCommandOptions& opt, RendererKind renderer, int round, PeerRequest request,
+                  std::vector<PeerRow>* rows, bool terminal) {
+  if (!rows->empty() && !rows->front().run.ran) return;  // absent or failing: once is enough
+  if (terminal) std::fprintf(stderr, "\rbench: peers, round %d/%d ", round + 1, opt.rounds);
+  const PeerRun run = renderer == RendererKind::Raytrace ? runEmbreeViewer(request) : runOsmesaPeer(request);
+  if (rows->empty()) {
+    rows->push_back({run, {}, {}});
+  } else {
+    PeerRun& all = rows->front().run;
+    all.frameMs.insert(all.frameMs.end(), run.frameMs.begin(), run.frameMs.end());
+    all.cpuMs.insert(all.cpuMs.end(), run.cpuMs.begin(), run.cpuMs.end());
+    if (!run.ran) all.error = run.error.empty() ? run.skipped : run.error;
   }
-  if (terminal) std::fputs("\r\033[K", stderr);
-  for (PeerRow& row : rows) {
-    std::vector<double> wall, cpu;
-    for (double ms : row.run.frameMs) wall.push_back(ms / 1e3);
-    for (double ms : row.run.cpuMs) cpu.push_back(ms / 1e3);
-    row.wall = spreadOf(wall);
-    row.cpu = spreadOf(cpu);
-  }
-  return rows;
+  PeerRow& row = rows->front();
+  std::vector<double> wall, cpu;
+  for (double ms : row.run.frameMs) wall.push_back(ms / 1e3);
+  for (double ms : row.run.cpuMs) cpu.push_back(ms / 1e3);
+  row.wall = spreadOf(wall);
+  row.cpu = spreadOf(cpu);
 }
 
 void printPeerTable(const BenchResult& ours, const Spread& wall, const Spread& cpu,
@@ -227,13 +205,25 @@ int runBenchCommand(BenchCommandOptions& opt) {
   request.frames = opt.frames;
   request.warmup = opt.warmup;
   if (terminal) request.progress = [](int i, int n) { std::fprintf(stderr, "\rbench: frame %d/%d", i, n); };
-
-  BenchResult result = runBench(request);
-  if (terminal) std::fputs("\r\033[K", stderr);
-  std::vector<double> ourWall = result.frameSeconds, ourCpu = result.cpuSeconds;
   std::vector<PeerRow> peers;
-  if (opt.peers) peers = runPeerRounds(opt, request, result, &ourWall, &ourCpu, terminal);
-  const Spread wall = spreadOf(ourWall), cpu = spreadOf(ourCpu);
+  if (opt.peers) {
+    request.rounds = opt.rounds;
+    request.afterRound = [&](int round, const Camera& camera) {
+      PeerRequest pr;
+      pr.scenePath = request.scenePath;
+      pr.camera = camera;
+      pr.spp = opt.settings.spp;
+      pr.threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+      pr.frames = opt.frames;
+      pr.workDir = opt.workDir + "/peers";
+      runPeerRound(opt, opt.settings.renderer, round, pr, &peers, terminal);
+    };
+  }
+
+  const BenchResult result = runBench(request);
+  if (terminal) std::fputs("\r\033[K", stderr);
+  const Spread& wall = result.frame;
+  const Spread& cpu = result.cpu;
 
   const std::string text = benchText(result);
   if (opt.peers) {
@@ -266,7 +256,6 @@ int runBenchCommand(BenchCommandOptions& opt) {
     nlohmann::json j = benchJson(result);
     if (opt.peers) {
       j["peerRounds"] = opt.rounds;
-      j["allRoundsFrameSeconds"] = ourWall;
       nlohmann::json list = nlohmann::json::array();
       for (const PeerRow& row : peers) {
         const PeerRun& p = row.run;

@@ -136,12 +136,13 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   });
   const double tileSeconds = secondsSince(start);
   out.timings.emplace_back("raster.tiles", tileSeconds);
+  ThreadCounters total;
+  for (const ThreadCounters& c : counters) total += c;
   {
     // The tile loop's wall time split among its passes in proportion to
     // their thread-seconds, so the parts add up to raster.tiles at any
     // thread count (as the ray caster splits primary and shade).
-    ThreadCounters sum;
-    for (const ThreadCounters& c : counters) sum += c;
+    const ThreadCounters& sum = total;
     const double busy = sum.depthSeconds + sum.shadeSeconds + sum.transparencySeconds + sum.resolveSeconds;
     const double scale = busy > 0.0 ? tileSeconds / busy : 0.0;
     out.timings.emplace_back("raster.tiles.depth", sum.depthSeconds * scale);
@@ -170,8 +171,6 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
                                          : "wireframe: hidden lines removed");
   }
 
-  ThreadCounters total;
-  for (const ThreadCounters& c : counters) total += c;
   reportCounters(sc, setups.size(), total, lights.stats, wirePixels, &out.counters);
   return out;
 }
