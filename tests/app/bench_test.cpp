@@ -49,6 +49,27 @@ TEST(Bench, EachFrameReportsItsOwnRays) {
   EXPECT_GT(raysPerSecond(four, "rays.primary"), 0.0);
 }
 
+// --peers: the peer runs after each round of ours, on the one prepared
+// scene; every round's frames are ours.
+TEST(Bench, RoundsCallBackAfterEachRoundWithTheCamera) {
+  BenchRequest request;
+  request.scenePath = kCornell;
+  request.settings = stability::renderSettingsFrom({"--renderer", "raytrace", "--size", "24", "16"});
+  request.frames = 2;
+  request.warmup = 1;
+  request.rounds = 3;
+  std::vector<int> rounds;
+  request.afterRound = [&](int round, const Camera& camera) {
+    rounds.push_back(round);
+    EXPECT_EQ(camera.width, 24);
+    EXPECT_EQ(camera.height, 16);
+  };
+  const BenchResult r = runBench(request);
+  EXPECT_EQ(rounds, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(r.frameSeconds.size(), 6u);
+  EXPECT_EQ(r.frame.count, 6);
+}
+
 TEST(Bench, HybridFramesCountTheirOwnShadowRays) {
   const std::vector<std::string> args{"--renderer", "hybrid", "--size", "40", "30", "--shadows", "rays"};
   const BenchResult one = bench(args, 1, 0);
