@@ -10,6 +10,8 @@
 
 #include <tbb/global_control.h>
 
+#include "app/sweep_table.h"
+
 namespace rastray {
 
 namespace {
@@ -151,11 +153,9 @@ std::string benchCsvHeader() {
 }
 
 std::string benchCsvRow(const BenchResult& r) {
-  char row[512];
-  std::string scene = r.scenePath;
-  for (char& c : scene)
-    if (c == ',' || c == '"') c = '_';  // a path with a comma stays one field
-  char bvh[32] = "";                    // empty without a ray caster
+  char row[4096];  // the scene path is the only field of unbounded length
+  const std::string scene = sweep::csvQuote(r.scenePath);
+  char bvh[32] = "";  // empty without a ray caster
   if (r.bvhBuildSeconds >= 0.0) std::snprintf(bvh, sizeof bvh, "%.3f", r.bvhBuildSeconds * 1e3);
   std::snprintf(row, sizeof row, "%s,%s,%d,%d,%d,%d,%llu,%.3f,%s,%.3f,%.3f,%.3f,%d,%.1f,%.3f", scene.c_str(),
                 toString(r.renderer), r.width, r.height, r.spp, r.threads,

@@ -16,6 +16,7 @@
 #include "app/bench_peers.h"
 #include "app/commands.h"
 #include "app/sweep_crossover_scene.h"
+#include "app/sweep_table.h"
 #include "common/error.h"
 
 namespace rastray {
@@ -152,9 +153,7 @@ void appendPeersCsv(const std::string& path, const BenchResult& ours, const Spre
   if (fresh)
     f << "scene,renderer,width,height,spp,threads,rastray_median_ms,rastray_cpu_ms,peer,peer_median_ms,"
          "peer_min_ms,peer_max_ms,peer_cpu_ms,ratio,cpu_ratio\n";
-  std::string scene = ours.scenePath;
-  for (char& c : scene)
-    if (c == ',' || c == '"') c = '_';
+  const std::string scene = sweep::csvQuote(ours.scenePath);
   for (const PeerRow& row : rows) {
     if (!row.run.ran) continue;
     char peerCpu[32] = "", cpuRatio[32] = "";  // empty: the peer reports no CPU time
@@ -162,7 +161,7 @@ void appendPeersCsv(const std::string& path, const BenchResult& ours, const Spre
       std::snprintf(peerCpu, sizeof peerCpu, "%.3f", row.cpu.median * 1e3);
       std::snprintf(cpuRatio, sizeof cpuRatio, "%.3f", row.cpu.median / cpu.median);
     }
-    char line[768];
+    char line[4096];  // the scene path is the only field of unbounded length
     std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%d,%.3f,%.3f,%s,%.3f,%.3f,%.3f,%s,%.3f,%s\n",
                   scene.c_str(), toString(ours.renderer), ours.width, ours.height, ours.spp, ours.threads,
                   wall.median * 1e3, cpu.median * 1e3, row.run.peer.c_str(), row.wall.median * 1e3,

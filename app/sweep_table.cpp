@@ -20,12 +20,16 @@ const std::vector<std::string> kErrorColumns = {
     "depth_mean_abs", "depth_max_abs", "depth_mean_rel",   "depth_max_rel",    "depth_pixels",
     "pixels"};
 
-std::string quote(const std::string& s) {
+}  // namespace
+
+std::string csvQuote(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
   std::string out = "\"";
   for (const char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
   return out + "\"";
 }
+
+namespace {
 
 // 17 significant digits: enough for any double to read back bit for bit.
 std::string num(double v) {
@@ -90,8 +94,9 @@ void setNumbers(CellResult& r, const std::vector<double>& v) {
   e.pixels = uint64_t(v[i++]);
 }
 
-// One CSV record (RFC 4180); false at the end of the input.
-bool readRecord(std::istream& in, std::vector<std::string>& fields) {
+}  // namespace
+
+bool readCsvRecord(std::istream& in, std::vector<std::string>& fields) {
   fields.clear();
   std::string field;
   bool quoted = false, any = false;
@@ -124,6 +129,8 @@ bool readRecord(std::istream& in, std::vector<std::string>& fields) {
   fields.push_back(field);
   return true;
 }
+
+namespace {
 
 nlohmann::json jsonNumber(double v) {
   if (std::isfinite(v)) return v;
@@ -167,12 +174,12 @@ bool isTimeColumn(const std::string& column) {
 std::string toCsv(const std::vector<VaryAxis>& vary, const std::vector<CellResult>& rows) {
   std::string out;
   const std::vector<std::string> columns = csvColumns(vary);
-  for (size_t i = 0; i < columns.size(); ++i) out += (i ? "," : "") + quote(columns[i]);
+  for (size_t i = 0; i < columns.size(); ++i) out += (i ? "," : "") + csvQuote(columns[i]);
   out += "\n";
   for (const CellResult& r : rows) {
-    out += std::to_string(r.index) + "," + quote(r.scene);
-    for (const std::string& v : r.values) out += "," + quote(v);
-    out += "," + quote(r.args);
+    out += std::to_string(r.index) + "," + csvQuote(r.scene);
+    for (const std::string& v : r.values) out += "," + csvQuote(v);
+    out += "," + csvQuote(r.args);
     for (const double v : numbers(r)) out += "," + num(v);
     out += "\n";
   }
@@ -184,12 +191,12 @@ std::vector<CellResult> readCsv(const std::string& path, const std::vector<VaryA
   if (!in) throw InputError(path, "", "cannot open");
   const std::vector<std::string> columns = csvColumns(vary);
   std::vector<std::string> fields;
-  if (!readRecord(in, fields) || fields != columns)
+  if (!readCsvRecord(in, fields) || fields != columns)
     throw InputError(path, "line 1",
                      "not the header of this sweep's CSV (expected " + std::to_string(columns.size()) +
                          " columns starting cell,scene)");
   std::vector<CellResult> rows;
-  for (int line = 2; readRecord(in, fields); ++line) {
+  for (int line = 2; readCsvRecord(in, fields); ++line) {
     if (fields.size() == 1 && fields[0].empty()) continue;
     if (fields.size() != columns.size())
       throw InputError(path, "line " + std::to_string(line),

@@ -6,9 +6,11 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 
 #include "app/bench.h"
 #include "app/stability_measure.h"
+#include "app/sweep_table.h"
 #include "tests/app/run_command.h"
 
 namespace rastray {
@@ -119,12 +121,21 @@ TEST(Bench, RasterReportsStagesAndNoBvh) {
 
 TEST(Bench, CsvRowMatchesItsHeader) {
   BenchResult r = bench({"--renderer", "raytrace", "--size", "16", "12"}, 1, 0);
-  const auto fields = [](const std::string& line) { return std::count(line.begin(), line.end(), ',') + 1; };
+  const auto fields = [](const std::string& line) {
+    std::istringstream in(line);
+    std::vector<std::string> record;
+    sweep::readCsvRecord(in, record);
+    return record.size();
+  };
   EXPECT_EQ(fields(benchCsvRow(r)), fields(benchCsvHeader()));
   EXPECT_NE(benchCsvRow(r).find(",raytrace,16,12,1,"), std::string::npos) << benchCsvRow(r);
   r.scenePath = "a,b.gltf";  // a comma in a path must not add a field
   r.bvhBuildSeconds = -1.0;  // nor an absent BVH remove one
   EXPECT_EQ(fields(benchCsvRow(r)), fields(benchCsvHeader()));
+  std::istringstream row(benchCsvRow(r));
+  std::vector<std::string> record;
+  ASSERT_TRUE(sweep::readCsvRecord(row, record));
+  EXPECT_EQ(record.front(), "a,b.gltf");  // quoted, read back whole
 }
 
 TEST(BenchCommand, LastLineIsTheMedianFrame) {
