@@ -18,6 +18,7 @@
 #include "app/sweep_crossover_scene.h"
 #include "app/sweep_table.h"
 #include "common/error.h"
+#include "common/interrupt.h"
 
 namespace rastray {
 
@@ -198,6 +199,9 @@ int runBenchCommand(BenchCommandOptions& opt) {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
   const bool terminal = isatty(STDERR_FILENO);
+  // Ctrl-C (common/interrupt.h): the frame in progress stops at its next
+  // tile; the tables are written only for a whole run.
+  installInterruptHandlers();
   BenchRequest request;
   request.scenePath = resolveScene(opt);
   request.settings = opt.settings;
@@ -221,6 +225,7 @@ int runBenchCommand(BenchCommandOptions& opt) {
 
   const BenchResult result = runBench(request);
   if (terminal) std::fputs("\r\033[K", stderr);
+  throwIfInterrupted();  // e.g. during a peer's round
   const Spread& wall = result.frame;
   const Spread& cpu = result.cpu;
 

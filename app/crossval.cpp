@@ -1,5 +1,6 @@
 #include "app/crossval.h"
 
+#include "common/interrupt.h"
 #include "compare/classify.h"
 
 namespace rastray {
@@ -41,6 +42,9 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
   r.camera = r.raytrace.camera;
   r.analysis = r.raytrace.analysis;
 
+  // Ctrl-C (common/interrupt.h) between the stages; the renderers check
+  // their tiles themselves.
+  throwIfInterrupted();
   say("compare");
   ClassifierSettings classifier;
   classifier.depthFormat = storedDepthFormat(settings.raster.depthFormat);
@@ -50,6 +54,7 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
   const FrameNames rasterNames{"raster", "raytrace"}, hybridNames{"hybrid", "raytrace"};
   r.rasterVsRay = compareVisibility(r.raster.output.samples, r.raytrace.output.samples, settings.spp,
                                     classifier, rasterNames);
+  throwIfInterrupted();
   r.hybridVsRay = compareVisibility(r.hybrid.output.samples, r.raytrace.output.samples, settings.spp,
                                     classifier, hybridNames);
   r.rasterVsRayColor = compareColors(r.raster.output.image, r.raytrace.output.image);

@@ -4,9 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "app/svg_plot.h"
 #include "common/error.h"
 #include "common/image.h"
-#include "app/svg_plot.h"
 #include "compare/maps.h"
 
 namespace rastray {
@@ -147,10 +147,22 @@ std::string colorTable(const ColorMetrics& m, const AgreeingColorStats& agree, c
   return s + "</table>";
 }
 
-std::string sceneName(const CrossvalResult& r) { return std::filesystem::path(r.scenePath).stem().string(); }
+std::string sceneName(const std::string& scenePath) {
+  return std::filesystem::path(scenePath).stem().string();
+}
 
-void writeScenePage(const std::string& dir, const CrossvalResult& r,
-                    const std::vector<ReportExplanation>& explain) {
+void createFolder(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir, "", "cannot create the folder: " + ec.message());
+}
+
+}  // namespace
+
+void writeCrossvalScenePage(const std::string& reportDir, const CrossvalResult& r,
+                            const std::vector<ReportExplanation>& explain) {
+  const std::string dir = reportDir + "/" + sceneName(r.scenePath);
+  createFolder(dir);
   const int w = r.camera.width, h = r.camera.height;
   writePng(dir + "/raster.png", r.raster.output.image);
   writePng(dir + "/raytrace.png", r.raytrace.output.image);
@@ -218,17 +230,12 @@ void writeScenePage(const std::string& dir, const CrossvalResult& r,
            "</td></tr>";
   }
   b += "</table>";
-  writeTextFile(dir + "/index.html", reportPage(sceneName(r) + " - rastray crossval", b));
+  writeTextFile(dir + "/index.html", reportPage(sceneName(r.scenePath) + " - rastray crossval", b));
 }
 
-}  // namespace
-
-void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResult>& results,
-                         const RenderSettings& settings,
-                         const std::vector<std::vector<ReportExplanation>>& explanations) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw InputError(dir, "", "cannot create the report folder: " + ec.message());
+void writeCrossvalIndex(const std::string& dir, const std::vector<CrossvalSummary>& results,
+                        const RenderSettings& settings) {
+  createFolder(dir);
 
   std::string b =
       "<h1>rastray cross-validation</h1><p>Each scene rendered by the rasterizer, the Embree ray caster "
@@ -242,18 +249,13 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
   b += "<th>cut off</th><th>max rel &Delta;Z</th><th>RMS</th><th>PSNR</th><th>hybrid &Delta; where hits "
        "agree</th>"
        "<th>raster s</th><th>raytrace s</th><th>hybrid s</th></tr>";
-  for (size_t i = 0; i < results.size(); ++i) {
-    const CrossvalResult& r = results[i];
-    const std::string name = sceneName(r);
-    const std::string sceneDir = dir + "/" + name;
-    std::filesystem::create_directories(sceneDir, ec);
-    if (ec) throw InputError(sceneDir, "", "cannot create the folder: " + ec.message());
-    writeScenePage(sceneDir, r, i < explanations.size() ? explanations[i] : std::vector<ReportExplanation>{});
+  for (const CrossvalSummary& r : results) {
+    const std::string name = sceneName(r.scenePath);
     const VisibilityReport& v = r.rasterVsRay;
     b += "<tr><td class=\"l\"><a href=\"" + escapeHtml(name) + "/index.html\">" + escapeHtml(name) +
-         "</a></td><td>" + std::to_string(r.camera.width) + "&times;" + std::to_string(r.camera.height) +
-         "</td><td>" + std::to_string(v.samples.compared) + "</td><td>" + std::to_string(v.layers.compared) +
-         "</td><td>" + percent(v.layers.agreement()) + "</td>";
+         "</a></td><td>" + std::to_string(r.width) + "&times;" + std::to_string(r.height) + "</td><td>" +
+         std::to_string(v.samples.compared) + "</td><td>" + std::to_string(v.layers.compared) + "</td><td>" +
+         percent(v.layers.agreement()) + "</td>";
     for (int c = 0; c < kMismatchClassCount; ++c) {
       const uint64_t n = v.layers.count(MismatchClass(c));
       const bool bad = MismatchClass(c) == MismatchClass::Genuine && n > 0;
@@ -263,9 +265,9 @@ void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResul
     b += "<td>" + fmt("%.3g", v.depth.maxRelative) + "</td><td>" + fmt("%.3g", r.rasterVsRayColor.rmsError) +
          "</td><td>" +
          (std::isinf(r.rasterVsRayColor.psnr) ? "&infin;" : fmt("%.1f", r.rasterVsRayColor.psnr)) +
-         "</td><td>" + fmt("%.3g", r.hybridWhereAgree.maxError) + "</td><td>" +
-         fmt("%.3f", r.raster.seconds) + "</td><td>" + fmt("%.3f", r.raytrace.seconds) + "</td><td>" +
-         fmt("%.3f", r.hybrid.seconds) + "</td></tr>";
+         "</td><td>" + fmt("%.3g", r.hybridWhereAgree.maxError) + "</td><td>" + fmt("%.3f", r.rasterSeconds) +
+         "</td><td>" + fmt("%.3f", r.raytraceSeconds) + "</td><td>" + fmt("%.3f", r.hybridSeconds) +
+         "</td></tr>";
   }
   b += "</table><h2>Mismatch classes</h2>" + mismatchLegendHtml();
   b += "<p>Shared-edge tie: both renderers hit triangles of one instance that share an edge, at a sample "

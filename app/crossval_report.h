@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/crossval.h"
+#include "app/crossval_record.h"
 
 namespace rastray {
 
@@ -17,9 +18,6 @@ struct ReportExplanation {
   std::string file;  // text file in the scene folder
 };
 
-// Writes DIR/index.html and DIR/<scene name>/...; every file atomically.
-// `explanations` (per scene, may be empty) link mismatch classes to
-// `rastray explain` output already written into the scene folders.
 // HTML pieces the other reports (rastray stability) share, so every page
 // looks alike: text escaped for HTML; a complete page with the house style
 // (no external resources); the mismatch-map legend (compare/maps.h colours).
@@ -27,8 +25,16 @@ std::string escapeHtml(const std::string& s);
 std::string reportPage(const std::string& title, const std::string& body);
 std::string mismatchLegendHtml();
 
-void writeCrossvalReport(const std::string& dir, const std::vector<CrossvalResult>& results,
-                         const RenderSettings& settings,
-                         const std::vector<std::vector<ReportExplanation>>& explanations);
+// The report is written scene by scene, as each finishes (so an
+// interrupted run keeps the pages of its finished scenes), then its index;
+// every file atomically.
+// DIR/<scene stem>/index.html and its images; `explanations` (may be
+// empty) link mismatch classes to `rastray explain` output already written
+// into that folder.
+void writeCrossvalScenePage(const std::string& dir, const CrossvalResult& result,
+                            const std::vector<ReportExplanation>& explanations);
+// DIR/index.html: one row per scene, linking to the scene pages.
+void writeCrossvalIndex(const std::string& dir, const std::vector<CrossvalSummary>& summaries,
+                        const RenderSettings& settings);
 
 }  // namespace rastray

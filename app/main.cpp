@@ -2,7 +2,9 @@
 //
 // Exit status (SPEC §7): 0 success; 1 a comparison fell below its
 // threshold; 2 bad usage or bad input, with one line on stderr naming the
-// file and the offending element.
+// file and the offending element; 128 + the signal's number (130, 143)
+// when Ctrl-C or SIGTERM stopped a render, crossval, sweep, bench or
+// stability run (common/interrupt.h), after a line saying what it finished.
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -12,6 +14,7 @@
 
 #include "app/commands.h"
 #include "common/error.h"
+#include "common/interrupt.h"
 
 namespace {
 
@@ -82,6 +85,9 @@ int main(int argc, char** argv) {
       if (status >= 0) return status;
     }
     return 2;
+  } catch (const Interrupted& e) {
+    printErrorLine("rastray: " + e.message());
+    return interruptedExitStatus(e.signal());
   } catch (const InputError& e) {
     printErrorLine(e.what());
     return 2;

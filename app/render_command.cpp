@@ -12,6 +12,7 @@
 #include "app/render_setup.h"
 #include "common/error.h"
 #include "common/image.h"
+#include "common/interrupt.h"
 
 namespace rastray {
 
@@ -48,10 +49,17 @@ int runRender(RenderCommandOptions& opt) {
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                     size_t(opt.settings.threads));
 
+  // Ctrl-C: the renderers stop at their next tile and throw Interrupted
+  // (common/interrupt.h); main() says "nothing written".
+  installInterruptHandlers();
   const Scene scene = loadSceneForRender(opt.scenePath, opt.settings);
+  throwIfInterrupted();
   RenderSettings settings = opt.settings;
   settings.keepSamples = opt.deep;
   const RenderRun run = renderScene(scene, settings);
+  // The last check: a write that has begun finishes (and renames its
+  // temporary file into place) even if a signal arrives during it.
+  throwIfInterrupted();
 
   if (opt.deep)
     writeDeepExr(opt.output, run.output.samples);

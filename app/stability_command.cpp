@@ -19,6 +19,7 @@
 #include "app/stability_report.h"
 #include "common/error.h"
 #include "common/image.h"
+#include "common/interrupt.h"
 
 namespace rastray {
 
@@ -118,6 +119,10 @@ int runStability(const StabilityOptions& opt) {
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                     size_t(opt.threads));
   const bool terminal = isatty(STDERR_FILENO);
+  // Ctrl-C (common/interrupt.h): the case in progress stops; the tables
+  // and the report index are written only for a whole run (the generated
+  // scenes' temporary folder is removed on the way out).
+  installInterruptHandlers();
   std::vector<stability::CaseResult> results;
   for (size_t i = 0; i < selected.size(); ++i) {
     const stability::Case& c = selected[i];
@@ -133,7 +138,12 @@ int runStability(const StabilityOptions& opt) {
       };
     stability::CaseResult result{c.name, c.group, c.parameters, c.quick, {}, {}};
     try {
+      throwIfInterrupted();
       result.rows = c.run(ctx, (std::filesystem::path(sceneDir) / (c.name + ".gltf")).string());
+    } catch (const Interrupted& e) {
+      if (terminal) std::fprintf(stderr, "\r\033[K");
+      throw e.withFinished(std::to_string(i) + " of " + std::to_string(selected.size()) +
+                           " cases finished, no table or report index written; " + c.name + " not finished");
     } catch (const std::exception& e) {
       // A case that cannot run is a failed case, not a bad input: the
       // others still run and the report shows which one broke.

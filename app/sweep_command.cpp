@@ -23,6 +23,7 @@
 #include "app/sweep_table.h"
 #include "common/error.h"
 #include "common/image.h"
+#include "common/interrupt.h"
 
 namespace rastray {
 
@@ -189,22 +190,42 @@ int runSweep(const SweepOptions& opt) {
 
   const bool terminal = isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
-  for (size_t i = 0; i < todo.size(); ++i) {
-    if (terminal) {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const std::string eta =
-          i == 0 ? "" : ", ETA " + duration(elapsed / double(i) * double(todo.size() - i));
-      std::string label = std::filesystem::path(todo[i]->scene).filename().string();
-      for (size_t v = 0; v < spec.vary.size(); ++v)
-        label += ", " + spec.vary[v].name + " " + todo[i]->values[v];
-      std::fprintf(stderr, "\r\033[K[%zu/%zu done%s] cell %zu: %s", i, todo.size(), eta.c_str(),
-                   todo[i]->index, label.c_str());
+  // Ctrl-C (common/interrupt.h): the cell in progress is dropped; the
+  // finished ones are in sweep.csv (written after each), for --resume.
+  installInterruptHandlers();
+  size_t finished = 0;
+  try {
+    for (size_t i = 0; i < todo.size(); ++i) {
+      throwIfInterrupted();
+      if (terminal) {
+        const double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const std::string eta =
+            i == 0 ? "" : ", ETA " + duration(elapsed / double(i) * double(todo.size() - i));
+        std::string label = std::filesystem::path(todo[i]->scene).filename().string();
+        for (size_t v = 0; v < spec.vary.size(); ++v)
+          label += ", " + spec.vary[v].name + " " + todo[i]->values[v];
+        std::fprintf(stderr, "\r\033[K[%zu/%zu done%s] cell %zu: %s", i, todo.size(), eta.c_str(),
+                     todo[i]->index, label.c_str());
+      }
+      rows.push_back(sweep::measureCell(*todo[i], spec.repeat, references));
+      std::sort(rows.begin(), rows.end(),
+                [](const sweep::CellResult& a, const sweep::CellResult& b) { return a.index < b.index; });
+      // After every cell: an interrupted run keeps what it measured (--resume).
+      writeTables(opt.reportDir, meta, rows);
+      ++finished;
     }
-    rows.push_back(sweep::measureCell(*todo[i], spec.repeat, references));
-    std::sort(rows.begin(), rows.end(),
-              [](const sweep::CellResult& a, const sweep::CellResult& b) { return a.index < b.index; });
-    // After every cell: an interrupted run keeps what it measured (--resume).
-    writeTables(opt.reportDir, meta, rows);
+  } catch (const Interrupted& e) {
+    if (terminal) std::fprintf(stderr, "\r\033[K");
+    std::string account = std::to_string(done.size() + finished) + " of " +
+                          std::to_string(done.size() + todo.size()) + " cells finished";
+    if (done.size() + finished > 0) account += " (in " + csv + "; --resume runs the rest)";
+    const sweep::Cell& c = *todo[finished];
+    account +=
+        "; cell " + std::to_string(c.index) + " (" + std::filesystem::path(c.scene).filename().string();
+    for (size_t v = 0; v < spec.vary.size(); ++v) account += ", " + spec.vary[v].name + " " + c.values[v];
+    account += ") not finished";
+    throw e.withFinished(account);
   }
   if (terminal) std::fprintf(stderr, "\r\033[K");
   writeTables(opt.reportDir, meta, rows);

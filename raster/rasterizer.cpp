@@ -12,6 +12,7 @@
 #include <string>
 
 #include "common/error.h"
+#include "common/interrupt.h"
 #include "raster/bin.h"
 #include "raster/clip.h"
 #include "raster/report.h"
@@ -128,12 +129,16 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   tbb::enumerable_thread_specific<ThreadCounters> counters;
   if (hits) hits->assign(size_t(camera.width) * size_t(camera.height) * size_t(options.spp), SampleHit{});
   tbb::parallel_for(0, tiles.count(), [&](int tile) {
+    // Ctrl-C (common/interrupt.h): the tiles not yet started are skipped,
+    // and the unfinished image is thrown away below.
+    if (interruptRequested()) return;
     const size_t t = size_t(tile);
     const TileBins bins{opaqueBins[t], analysis.transparency ? &blendBins[t] : nullptr};
     const TileOutputs outputs{&out.image, options.keepSamples ? &deep[t] : nullptr,
                               options.keepSamples ? &deepCounts[t] : nullptr, hits};
     renderer.render(tiles.rect(tile), bins, &target, outputs, counters.local());
   });
+  throwIfInterrupted();
   const double tileSeconds = secondsSince(start);
   out.timings.emplace_back("raster.tiles", tileSeconds);
   ThreadCounters total;

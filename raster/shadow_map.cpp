@@ -7,6 +7,7 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/interrupt.h"
 #include "common/math_constants.h"
 
 namespace rastray {
@@ -168,6 +169,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         };
       std::vector<std::vector<Attenuation>> perTile(size_t(tiles.count()));
       tbb::parallel_for(0, tiles.count(), [&](int tile) {
+        if (interruptRequested()) return;  // Ctrl-C: thrown below
         DepthPassCounters dc;
         const TileRect rect = tiles.rect(tile);
         rasterDepthPass(setups, bins[size_t(tile)], grid, rect, kMapFormat, DepthFunc::Less, alphaTest,
@@ -192,6 +194,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
           });
         }
       });
+      throwIfInterrupted();
       for (const auto& v : perTile) map.attenuation.insert(map.attenuation.end(), v.begin(), v.end());
       std::sort(map.attenuation.begin(), map.attenuation.end(),
                 [](const Attenuation& a, const Attenuation& b) {

@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "common/interrupt.h"
 #include "common/sampling.h"
 #include "raytrace/ray_caster_parts.h"
 
@@ -136,12 +137,16 @@ RenderOutput renderPrimaryVisibility(const CasterState& state) {
   tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY), [&](const tbb::blocked_range<int>& range) {
     TileScratch& local = scratch.local();
     for (int t = range.begin(); t != range.end(); ++t) {
+      // Ctrl-C (common/interrupt.h): the tiles not yet started are
+      // skipped, and the unfinished image is thrown away below.
+      if (interruptRequested()) return;
       const int x0 = (t % tilesX) * size, y0 = (t / tilesX) * size;
       const Tile tile{x0, y0, std::min(x0 + size, camera.width), std::min(y0 + size, camera.height)};
       renderTile(state, tile, positions, centre, local, &out.image,
                  options.keepSamples ? &deep.tiles[size_t(t)] : nullptr, &deep.pixelCounts);
     }
   });
+  throwIfInterrupted();
   const double tilesWall = secondsBetween(start, Clock::now());
   double primary = 0.0, shade = 0.0;
   for (const TileScratch& local : scratch) {

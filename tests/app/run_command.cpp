@@ -5,9 +5,12 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 namespace rastray::test {
 
@@ -20,7 +23,8 @@ std::string slurp(const std::string& path) {
 }
 }  // namespace
 
-CommandResult runRastray(const std::vector<std::string>& args) {
+CommandResult runRastrayAndSignal(const std::vector<std::string>& args, int signal,
+                                  const std::function<bool(pid_t)>& ready, bool* signalled) {
   static std::atomic<int> counter{0};
   const std::string base = "run_" + std::to_string(getpid()) + "_" + std::to_string(counter++);
   const std::string outPath = base + ".out", errPath = base + ".err";
@@ -40,7 +44,21 @@ CommandResult runRastray(const std::vector<std::string>& args) {
     _exit(127);
   }
   int wstatus = 0;
-  waitpid(pid, &wstatus, 0);
+  bool sent = false;
+  if (ready) {
+    while (waitpid(pid, &wstatus, WNOHANG) == 0) {
+      if (ready(pid)) {
+        kill(pid, signal);
+        sent = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    if (sent) waitpid(pid, &wstatus, 0);
+  } else {
+    waitpid(pid, &wstatus, 0);
+  }
+  if (signalled) *signalled = sent;
   CommandResult r;
   r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
   r.out = slurp(outPath);
@@ -48,6 +66,22 @@ CommandResult runRastray(const std::vector<std::string>& args) {
   std::remove(outPath.c_str());
   std::remove(errPath.c_str());
   return r;
+}
+
+CommandResult runRastray(const std::vector<std::string>& args) {
+  return runRastrayAndSignal(args, 0, nullptr);
+}
+
+bool catchesStopSignals(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("SigCgt:", 0) != 0) continue;
+    const unsigned long long mask = std::stoull(line.substr(7), nullptr, 16);
+    const unsigned long long wanted = (1ull << (SIGINT - 1)) | (1ull << (SIGTERM - 1));
+    return (mask & wanted) == wanted;
+  }
+  return false;
 }
 
 }  // namespace rastray::test
