@@ -18,5 +18,6 @@ CommandRunner addCompareCommand(CLI::App& app);
 CommandRunner addStabilityCommand(CLI::App& app);
 CommandRunner addSweepCommand(CLI::App& app);
 CommandRunner addBenchCommand(CLI::App& app);
+CommandRunner addServeCommand(CLI::App& app);
 
 }  // namespace rastray

@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
   commands.push_back(addStabilityCommand(app));
   commands.push_back(addSweepCommand(app));
   commands.push_back(addBenchCommand(app));
+  commands.push_back(addServeCommand(app));
 #endif
   commands.push_back(addCompareCommand(app));
 

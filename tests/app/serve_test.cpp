@@ -1,0 +1,391 @@
+// `rastray serve`: the explorer's HTTP endpoints, with the server running in
+// this process on a free port (app/serve_server.h).
+#ifdef RASTRAY_HAVE_RENDERERS
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include "app/serve_api.h"
+#include "app/serve_server.h"
+#include "run_command.h"
+
+namespace rastray {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string scenePath(const char* name) { return std::string(RASTRAY_SCENES) + "/" + name + ".gltf"; }
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Width and height from a PNG's IHDR chunk (big-endian, bytes 16-23).
+std::pair<int, int> pngSize(const std::string& png) {
+  EXPECT_GE(png.size(), 24u);
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  auto u32 = [&](size_t at) {
+    uint32_t v = 0;
+    for (size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(png[at + i]);
+    return int(v);
+  };
+  return {u32(16), u32(20)};
+}
+
+// Splits the shell words shellQuote writes: plain words and '...' quoting.
+std::vector<std::string> shellWords(const std::string& line) {
+  std::vector<std::string> words;
+  std::string word;
+  bool inWord = false, quoted = false, escaped = false;
+  for (const char c : line) {
+    if (escaped) {
+      word += c;  // the character after a backslash, outside quotes
+      escaped = false;
+    } else if (quoted) {
+      if (c == '\'')
+        quoted = false;
+      else
+        word += c;
+    } else if (c == '\'') {
+      quoted = inWord = true;
+    } else if (c == '\\') {
+      escaped = inWord = true;
+    } else if (c == ' ') {
+      if (inWord) words.push_back(word);
+      word.clear();
+      inWord = false;
+    } else {
+      word += c;
+      inWord = true;
+    }
+  }
+  if (inWord) words.push_back(word);
+  return words;
+}
+
+// A root directory with one scene inside, one beside it (outside), and a
+// link from inside to the outside one.
+class ServeTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    base_ = fs::temp_directory_path() / ("rastray-serve-test-" + std::to_string(getpid()));
+    fs::create_directories(base_ / "root" / "sub");
+    fs::copy_file(scenePath("three-triangles"), base_ / "root" / "sub" / "three-triangles.gltf");
+    fs::copy_file(scenePath("three-triangles"), base_ / "secret.gltf");
+    fs::create_symlink(base_ / "secret.gltf", base_ / "root" / "escape.gltf");
+    serve::ServeOptions options;
+    options.scenes = {scenePath("cornell-box")};
+    options.root = (base_ / "root").string();
+    options.port = 0;
+    server_ = new serve::ExplorerServer(options);
+    port_ = server_->bind();
+    thread_ = std::thread([] { server_->run(); });
+  }
+  static void TearDownTestSuite() {
+    server_->stop();
+    thread_.join();
+    delete server_;
+    fs::remove_all(base_);
+  }
+
+  static httplib::Result get(const std::string& target, const std::string& host = "127.0.0.1") {
+    httplib::Client client("127.0.0.1", port_);
+    client.set_read_timeout(120, 0);
+    return client.Get(target.c_str(), {{"Host", host}});
+  }
+  static std::string cornell() {
+    return "scene=" + httplib::detail::encode_query_param(scenePath("cornell-box"));
+  }
+
+  static inline fs::path base_;
+  static inline serve::ExplorerServer* server_ = nullptr;
+  static inline int port_ = 0;
+  static inline std::thread thread_;
+};
+
+TEST_F(ServeTest, PageAndItsFilesAreServedWithoutNetworkResources) {
+  const auto page = get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("<script src=\"/explorer.js\">"), std::string::npos);
+  // No URL but the SVG namespace's name (which is never fetched).
+  auto urls = [](std::string text) {
+    const std::string svg = "http://www.w3.org/2000/svg";
+    for (size_t at; (at = text.find(svg)) != std::string::npos;) text.erase(at, svg.size());
+    return text.find("http://") != std::string::npos || text.find("https://") != std::string::npos;
+  };
+  EXPECT_FALSE(urls(page->body));
+  for (const char* path : {"/explorer.js", "/explorer.css"}) {
+    const auto r = get(path);
+    ASSERT_TRUE(r) << path;
+    EXPECT_EQ(r->status, 200) << path;
+    EXPECT_FALSE(urls(r->body)) << path;
+  }
+  EXPECT_NE(page->get_header_value("Content-Security-Policy").find("default-src 'self'"), std::string::npos);
+}
+
+TEST_F(ServeTest, RenderReturnsPngOfTheAskedSize) {
+  for (const char* renderer : {"raster", "raytrace", "hybrid"}) {
+    const auto r = get("/api/image?" + cornell() + "&size=96,72&spp=4&renderer=" + renderer);
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << r->body;
+    EXPECT_EQ(r->get_header_value("Content-Type"), "image/png");
+    EXPECT_EQ(pngSize(r->body), std::make_pair(96, 72)) << renderer;
+  }
+  const auto frame = get("/api/frame?" + cornell() + "&size=64,48&renderer=hybrid");
+  ASSERT_TRUE(frame);
+  ASSERT_EQ(frame->status, 200) << frame->body;
+  const json j = json::parse(frame->body);
+  EXPECT_EQ(j["schema"], "rastray.serve.frame");
+  EXPECT_EQ(j["size"], json::array({64, 48}));
+  EXPECT_EQ(j["image"].get<std::string>().rfind("data:image/png;base64,iVBORw0KGgo", 0), 0u);
+  // The work of the render: what `render --json` reports.
+  const json& work = j["renders"][0];
+  EXPECT_EQ(work["renderer"], "hybrid");
+  EXPECT_GT(work["counters"]["rays.shadow"].get<uint64_t>(), 0u);
+  EXPECT_FALSE(work["passesLeftOut"].empty());
+  EXPECT_TRUE(work["timings"].contains("raster.tiles"));
+}
+
+TEST_F(ServeTest, PreparedRendererIsKeptBetweenRequests) {
+  const std::string target = "/api/frame?" + cornell() + "&size=40,30&renderer=raytrace&cull=back";
+  const auto first = get(target), second = get(target);
+  ASSERT_TRUE(first && second);
+  ASSERT_EQ(first->status, 200) << first->body;
+  const json a = json::parse(first->body), b = json::parse(second->body);
+  EXPECT_EQ(a["renders"][0]["preparation"], "built");
+  EXPECT_TRUE(a["renders"][0]["timings"].contains("raytrace.bvh_build"));
+  EXPECT_EQ(b["renders"][0]["preparation"], "reused");
+  EXPECT_FALSE(b["renders"][0]["timings"].contains("raytrace.bvh_build"));
+  EXPECT_EQ(a["image"], b["image"]);
+}
+
+TEST_F(ServeTest, MapsComeFromCrossvalAndMatchItsReport) {
+  const std::string settings = "&size=48,36&spp=4&shadow-map-size=256";
+  for (const char* view : {"mismatch", "depth-diff", "color-diff"}) {
+    const auto r = get("/api/frame?" + cornell() + settings + "&view=" + view);
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << r->body;
+    const json j = json::parse(r->body);
+    EXPECT_EQ(j["renders"].size(), 3u) << view;
+    EXPECT_EQ(j["comparison"]["visibility"]["compared"].get<uint64_t>(), 48u * 36u * 4u) << view;
+    EXPECT_TRUE(j.contains(std::string(view) == "mismatch" ? "legend" : "colorBar")) << view;
+    EXPECT_EQ(j["command"].get<std::string>().rfind("rastray crossval ", 0), 0u) << view;
+  }
+  // The same pictures as `rastray crossval --report` writes.
+  const fs::path report = base_ / "report";
+  auto words =
+      shellWords(json::parse(get("/api/frame?" + cornell() + settings + "&view=mismatch")->body)["command"]);
+  ASSERT_EQ(words.back(), "report");
+  words.back() = report.string();
+  const auto run = test::runRastray(std::vector<std::string>(words.begin() + 1, words.end()));
+  ASSERT_EQ(run.status, 0) << run.err;
+  for (const auto& [view, file] :
+       {std::pair{"mismatch", "mismatch.png"}, std::pair{"depth-diff", "depth-diff.png"},
+        std::pair{"color-diff", "color-diff.png"}}) {
+    const auto r = get("/api/image?" + cornell() + settings + "&view=" + view);
+    EXPECT_EQ(r->body, slurp(report / "cornell-box" / file)) << view;
+  }
+}
+
+TEST_F(ServeTest, ExplainReturnsTheExplanationAndTheRayTreeOnTheImage) {
+  const auto r = get("/api/explain?" + cornell() + "&size=80,60&spp=4&x=50&y=30");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json j = json::parse(r->body);
+  EXPECT_EQ(j["schema"], "rastray.serve.explain");
+  EXPECT_EQ(j["command"].get<std::string>().find("rastray explain "), 0u);
+  const json& e = j["explain"];
+  EXPECT_EQ(e["schema"], "rastray.explain");
+  EXPECT_EQ(e["pixel"], json::array({50, 30}));
+  ASSERT_EQ(e["samples"].size(), 4u);
+  for (const json& sample : e["samples"]) {
+    ASSERT_FALSE(sample["layers"].empty());
+    EXPECT_TRUE(sample["layers"][0].contains("verdict"));
+    EXPECT_FALSE(sample["layers"][0]["raytrace"].is_null());
+  }
+  EXPECT_FALSE(e["raster"]["events"].empty());
+  EXPECT_NE(j["text"].get<std::string>().find("== hits per sample"), std::string::npos);
+  // The ray tree projected onto the image: each primary ray's hit lands on
+  // its sample's position, and each sample has a shadow ray towards the light.
+  int primaries = 0, shadows = 0;
+  for (const json& ray : j["rays"]) {
+    if (ray["kind"] == "shadow") ++shadows;
+    if (ray["kind"] != "primary") continue;
+    ++primaries;
+    const json& position = e["samples"][ray["sample"].get<size_t>()]["position"];
+    EXPECT_NEAR(ray["to"][0].get<double>(), position[0].get<double>(), 1e-4);
+    EXPECT_NEAR(ray["to"][1].get<double>(), position[1].get<double>(), 1e-4);
+  }
+  EXPECT_EQ(primaries, 4);
+  EXPECT_GE(shadows, 4);
+
+  // The same explanation as the command line gives.
+  auto words = shellWords(j["command"]);
+  words.push_back("--json");
+  const auto run = test::runRastray(std::vector<std::string>(words.begin() + 1, words.end()));
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_EQ(json::parse(run.out)["samples"], e["samples"]);
+}
+
+TEST_F(ServeTest, BadParametersGet400WithTheCommandsMessage) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"/api/image?" + cornell() + "&spp=9", "spp: 9 is not supported"},
+      {"/api/image?" + cornell() + "&spp=abc", "--spp"},
+      {"/api/image?" + cornell() + "&size=0,10", "--size"},
+      {"/api/image?" + cornell() + "&size=20000,10", "--size"},
+      {"/api/image?" + cornell() + "&size=10", "size: '10': needs 2 values"},
+      {"/api/image?" + cornell() + "&max-depth=65&renderer=raytrace", "--max-depth"},
+      {"/api/image?" + cornell() + "&renderer=vulkan", "renderer: 'vulkan' is not one of"},
+      {"/api/image?" + cornell() + "&renderer=raytrace&shadow-map-size=512",
+       "shadow-map-size: applies to raster"},
+      {"/api/image?" + cornell() + "&transparency=peel:0", "transparency: peel layer count"},
+      {"/api/image?" + cornell() + "&wireframe=yes", "wireframe: 'yes': a flag takes on or off"},
+      {"/api/image?" + cornell() + "&spp=4&spp=8", "spp: given more than once"},
+      {"/api/image?" + cornell() + "&view=depth", "view: 'depth' is not one of"},
+      {"/api/image?" + cornell() + "&view=mismatch&renderer=raster",
+       "renderer: the mismatch view runs every"},
+      {"/api/image?size=10,10", "scene: missing"},
+      {"/api/explain?" + cornell() + "&size=10,10&x=10&y=0", "x, y: pixel (10, 0) lies outside"},
+      {"/api/explain?" + cornell() + "&x=1", "x, y: the pixel to explain is missing"},
+      {"/api/explain?" + cornell() + "&x=-1&y=0", "x: '-1' is not a pixel coordinate"},
+  };
+  for (const auto& [target, message] : cases) {
+    const auto r = get(target);
+    ASSERT_TRUE(r) << target;
+    EXPECT_EQ(r->status, 400) << target;
+    EXPECT_NE(r->body.find(message), std::string::npos) << target << " -> " << r->body;
+  }
+}
+
+TEST_F(ServeTest, UnknownParameterGets400) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"/api/image?" + cornell() + "&colour=red", "unknown parameter 'colour'"},
+      {"/api/image?" + cornell() + "&--spp=4", "unknown parameter '--spp'"},
+      {"/api/image?" + cornell() + "&x=3", "unknown parameter 'x'"},  // only explain takes a pixel
+      {"/api/image?" + cornell() + "&threads=2", "threads: set by the server"},
+      {"/api/image?" + cornell() + "&debug-pixel=1,1", "debug-pixel: set by the server"},
+      {"/api/options?verbose=1", "unknown parameter 'verbose'"},
+      {"/api/scene?" + cornell() + "&spp=4", "unknown parameter 'spp'"},
+  };
+  for (const auto& [target, message] : cases) {
+    const auto r = get(target);
+    ASSERT_TRUE(r) << target;
+    EXPECT_EQ(r->status, 400) << target;
+    EXPECT_NE(r->body.find(message), std::string::npos) << target << " -> " << r->body;
+  }
+}
+
+TEST_F(ServeTest, OnlyNamedScenesAndFilesUnderTheRootCanBeOpened) {
+  const auto listed = get("/api/scenes");
+  ASSERT_TRUE(listed);
+  EXPECT_EQ(json::parse(listed->body)["scenes"],
+            json::array({scenePath("cornell-box"), "sub/three-triangles.gltf"}));
+  EXPECT_EQ(get("/api/image?scene=sub/three-triangles.gltf&size=16,12")->status, 200);
+  EXPECT_EQ(get("/api/image?scene=sub%2Fthree-triangles.gltf&size=16,12")->status, 200);
+
+  const std::string secret = (base_ / "secret.gltf").string();
+  const std::vector<std::string> refused = {
+      "../secret.gltf",                                    // climbing
+      "%2e%2e/secret.gltf",                                // climbing, encoded
+      "%2E%2E%2Fsecret.gltf",                              // and the slash too
+      "sub/../../secret.gltf",                             // climbing from a subdirectory
+      "sub%2F%2e%2e%2F%2e%2e%2Fsecret.gltf",               // likewise, encoded
+      "sub/%2e%2e/%2e%2e/secret.gltf",                     //
+      httplib::detail::encode_query_param(secret),         // absolute path
+      httplib::detail::encode_query_param("/etc/passwd"),  //
+      "escape.gltf",                                       // a link out of the root
+      "%252e%252e%252fsecret.gltf",                        // double-encoded: a name, not a path
+      "sub",                                               // a directory
+      "missing.gltf",
+  };
+  for (const std::string& name : refused) {
+    const auto r = get("/api/image?scene=" + name + "&size=16,12");
+    ASSERT_TRUE(r) << name;
+    EXPECT_TRUE(r->status == 403 || r->status == 404) << name << " -> " << r->status << " " << r->body;
+  }
+  // The URL path itself opens nothing but the page and the API.
+  for (const char* path :
+       {"/../secret.gltf", "/%2e%2e/%2e%2e/etc/passwd", "/api/../../etc/passwd", "/etc/passwd"})
+    EXPECT_EQ(get(path)->status, 404) << path;
+}
+
+TEST_F(ServeTest, RequestsForAnotherHostNameAreRefused) {
+  // A page elsewhere whose DNS name is rebound to 127.0.0.1 is refused.
+  EXPECT_EQ(get("/api/scenes", "attacker.example:80")->status, 403);
+  EXPECT_EQ(get("/api/scenes", "localhost:" + std::to_string(port_))->status, 200);
+}
+
+TEST_F(ServeTest, OlderRequestOfTheSameClientIsSuperseded) {
+  const std::string target = "/api/image?" + cornell() + "&size=16,12&client=page1&seq=";
+  EXPECT_EQ(get(target + "5")->status, 200);
+  const auto older = get(target + "3");
+  EXPECT_EQ(older->status, 409);
+  EXPECT_NE(older->body.find("superseded by request 5"), std::string::npos);
+  EXPECT_EQ(get(target + "6")->status, 200);
+  EXPECT_EQ(get("/api/image?" + cornell() + "&size=16,12&client=page2&seq=1")->status, 200);
+}
+
+// The command line the page shows renders the same image: the settings
+// round-trip through `rastray render`.
+TEST_F(ServeTest, SettingsRoundTripThroughTheCommandLine) {
+  const std::vector<std::string> settings = {
+      "&renderer=raster&size=64,48&spp=4&shadow-map-size=512&depth-format=unorm24&transparency=peel:2",
+      "&renderer=hybrid&size=48,40&shadows=map&shadow-bias=0.001,2&cull=back&texture-filter=nearest",
+      "&renderer=hybrid&size=48,40&shadows=none&max-depth=0&wireframe=on&halo=on",
+      "&renderer=raytrace&size=50,30&spp=2&max-depth=0&origin=world&eye=1.5,0.25,3&target=0,0,0&up=0,1,0",
+      "&renderer=raytrace&size=40,30&transparency-cutoff=0&ray-offset=float-ulps&no-packets=on&yfov=60",
+  };
+  int index = 0;
+  for (const std::string& s : settings) {
+    const auto frame = get("/api/frame?" + cornell() + s);
+    ASSERT_TRUE(frame);
+    ASSERT_EQ(frame->status, 200) << s << ": " << frame->body;
+    const std::string command = json::parse(frame->body)["command"];
+    std::vector<std::string> words = shellWords(command);
+    ASSERT_GE(words.size(), 5u) << command;
+    ASSERT_EQ(words[0], "rastray");
+    ASSERT_EQ(words.back(), "render.png") << command;
+    const fs::path out = base_ / ("roundtrip-" + std::to_string(index++) + ".png");
+    words.back() = out.string();
+    const auto run = test::runRastray(std::vector<std::string>(words.begin() + 1, words.end()));
+    ASSERT_EQ(run.status, 0) << command << "\n" << run.err;
+    const auto image = get("/api/image?" + cornell() + s);
+    EXPECT_EQ(image->body, slurp(out)) << command;
+  }
+}
+
+TEST(ServeApi, ShellQuotingKeepsEveryWord) {
+  EXPECT_EQ(serve::shellQuote("scenes/cornell-box.gltf"), "scenes/cornell-box.gltf");
+  EXPECT_EQ(serve::shellQuote("my scene.gltf"), "'my scene.gltf'");
+  EXPECT_EQ(serve::shellQuote("it's"), "'it'\\''s'");
+  EXPECT_EQ(serve::shellQuote(""), "''");
+  EXPECT_EQ(shellWords("rastray 'it'\\''s' 'a b' c"),
+            (std::vector<std::string>{"rastray", "it's", "a b", "c"}));
+}
+
+TEST(ServeApi, Base64MatchesRfc4648) {
+  EXPECT_EQ(serve::base64(""), "");
+  EXPECT_EQ(serve::base64("f"), "Zg==");
+  EXPECT_EQ(serve::base64("fo"), "Zm8=");
+  EXPECT_EQ(serve::base64("foo"), "Zm9v");
+  EXPECT_EQ(serve::base64("foobar"), "Zm9vYmFy");
+  EXPECT_EQ(serve::base64(std::string("\xff\x00\x10", 3)), "/wAQ");
+}
+
+}  // namespace
+}  // namespace rastray
+
+#endif  // RASTRAY_HAVE_RENDERERS

@@ -1,0 +1,682 @@
+// rastray explorer: the page of `rastray serve`. The settings on the left
+// become the query of /api/frame (images, maps, work) and /api/explain (one
+// pixel); the server parses them as `rastray render` / `crossval` /
+// `explain` would and shows the equivalent command line. Plain script, no
+// build step, nothing loaded from elsewhere.
+'use strict';
+
+const $ = (id) => document.getElementById(id);
+const ALL = ['raster', 'raytrace', 'hybrid'];
+
+const state = {
+  scene: '',
+  renderer: 'raster',
+  view: 'image',
+  pair: 'raster',
+  swipeWith: 'raytrace',
+  size: [640, 480],
+  options: {}, // render option name -> value, only those set away from the default
+  camera: null, // null: the scene's camera; else {eye, target, up}
+  sceneInfo: null,
+};
+let optionTable = [];
+const client = Math.random().toString(36).slice(2, 10);
+let seq = 0;
+let lastFrame = null; // the last final frame shown: {width, height}
+let explainedPixel = null;
+
+// ---- small vector helpers (camera) ----------------------------------------
+const add = (a, b) => a.map((v, i) => v + b[i]);
+const sub = (a, b) => a.map((v, i) => v - b[i]);
+const mul = (a, s) => a.map((v) => v * s);
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const norm = (a) => mul(a, 1 / Math.hypot(a[0], a[1], a[2]));
+// Rodrigues: v turned by `angle` around unit `axis`.
+function rotate(v, axis, angle) {
+  const c = Math.cos(angle), s = Math.sin(angle);
+  return add(add(mul(v, c), mul(cross(axis, v), s)), mul(axis, dot(axis, v) * (1 - c)));
+}
+// Numbers as the command line shows them: 9 significant digits, no noise.
+const fmt = (x) => String(Number(x.toPrecision(9)));
+
+// ---- which options apply (mirrors RenderSettings::applies) ----------------
+function shadowMode(kind, all) {
+  if (kind === 'raytrace' || (kind === 'hybrid' && all)) return 'rays';
+  const given = state.options.shadows;
+  if (all) return given && given !== 'rays' ? given : 'map';
+  return given || (kind === 'raster' ? 'map' : 'rays');
+}
+
+function shadowsValid(value, kind) {
+  if (value === 'rays') return kind !== 'raster';
+  return kind !== 'raytrace';
+}
+
+function applies(opt, all, renderer) {
+  const kinds = all ? ALL : [renderer];
+  return kinds.some((k) => opt.renderers.includes(k) &&
+    (opt.condition === 'always' ||
+     (opt.condition === 'shadow-maps' && shadowMode(k, all) === 'map') ||
+     (opt.condition === 'wireframe' && state.options.wireframe === 'on')));
+}
+
+function optionApplies(name, all, renderer) {
+  const opt = optionTable.find((o) => o.name === name);
+  if (!opt || !applies(opt, all, renderer)) return false;
+  if (name === 'shadows' && !all) return shadowsValid(state.options.shadows, renderer);
+  return true;
+}
+
+// ---- the query of a request -------------------------------------------------
+// all: the maps and explain run every renderer (no renderer parameter).
+function renderQuery(all, renderer, overrides) {
+  const q = new URLSearchParams();
+  q.set('scene', state.scene);
+  if (!all) q.set('renderer', renderer);
+  q.set('size', state.size.join(','));
+  if (state.camera) {
+    for (const k of ['eye', 'target', 'up']) q.set(k, state.camera[k].map(fmt).join(','));
+  }
+  const options = Object.assign({}, state.options, overrides || {});
+  for (const [name, value] of Object.entries(options)) {
+    if (value !== undefined && value !== '' && optionApplies(name, all, renderer)) q.set(name, value);
+  }
+  return q;
+}
+
+async function getJson(url, signal) {
+  const res = await fetch(url, {signal});
+  if (res.status === 409) throw new DOMException('superseded', 'AbortError');
+  if (!res.ok) throw new Error((await res.text()).trim() || res.statusText);
+  return res.json();
+}
+
+function setStatus(text, isError) {
+  $('status').textContent = text;
+  $('status').classList.toggle('error', !!isError);
+}
+
+// ---- frames -----------------------------------------------------------------
+let frameAbort = null;
+let previewBusy = false;
+let previewAgain = false;
+let dragging = false;
+let firstFrameDone = null; // resolves when the first final frame is on screen (selftest)
+const firstFrame = new Promise((resolve) => { firstFrameDone = resolve; });
+
+async function fetchFrame(query, signal) {
+  query.set('client', client);
+  query.set('seq', String(++seq));
+  return getJson('/api/frame?' + query.toString(), signal);
+}
+
+function loadImage(img, src) {
+  return new Promise((resolve, reject) => {
+    img.onload = () => resolve();
+    img.onerror = () => reject(new Error('the image did not decode'));
+    img.src = src;
+  });
+}
+
+// preview: 1 spp of the image view while the camera moves; else the view
+// and settings chosen.
+async function requestFrame(preview) {
+  if (!state.scene) return;
+  if (preview && previewBusy) { previewAgain = true; return; }
+  if (frameAbort) frameAbort.abort();
+  const ctl = new AbortController();
+  frameAbort = ctl;
+  previewBusy = preview;
+  setStatus(preview ? 'preview (1 spp)…' : 'rendering…');
+  const started = performance.now();
+  try {
+    if (preview) await showPreview(ctl.signal);
+    else await showFinal(ctl.signal);
+    const ms = Math.round(performance.now() - started);
+    setStatus((preview ? 'preview, ' : '') + ms + ' ms');
+    if (!preview) firstFrameDone();
+  } catch (e) {
+    if (e.name !== 'AbortError') setStatus(e.message, true);
+    if (e.name !== 'AbortError' && !preview) failSelftest('frame: ' + e.message);
+  } finally {
+    if (frameAbort === ctl) frameAbort = null;
+    if (preview) {
+      previewBusy = false;
+      if (previewAgain && dragging) { previewAgain = false; requestFrame(true); }
+    }
+  }
+}
+
+async function showPreview(signal) {
+  const j = await fetchFrame(renderQuery(false, state.renderer, {spp: '1'}), signal);
+  await loadImage($('image-a'), j.image);
+  $('image-b').hidden = true;
+}
+
+async function showFinal(signal) {
+  const view = state.view;
+  const all = view !== 'image' && view !== 'swipe';
+  const query = renderQuery(all, state.renderer);
+  if (all) { query.set('view', view); query.set('pair', state.pair); }
+  const a = await fetchFrame(query, signal);
+  let b = null;
+  if (view === 'swipe') b = await fetchFrame(renderQuery(false, state.swipeWith), signal);
+  await loadImage($('image-a'), a.image);
+  if (b) await loadImage($('image-b'), b.image);
+  $('image-b').hidden = !b;
+  applySwipe();
+  lastFrame = {width: a.size[0], height: a.size[1]};
+  sizeOverlay();
+  $('command').textContent = a.command;
+  showLegend(a);
+  showWork(a, b);
+  rememberInUrl();
+  if (explainedPixel) clearExplain();
+}
+
+function applySwipe() {
+  // The second renderer shows right of the slider.
+  $('image-b').style.clipPath = 'inset(0 0 0 ' + $('swipe').value + '%)';
+  $('swipe').hidden = state.view !== 'swipe';
+}
+
+function sizeOverlay() {
+  if (!lastFrame) return;
+  $('overlay').setAttribute('viewBox', '0 0 ' + lastFrame.width + ' ' + lastFrame.height);
+}
+
+// ---- legend and work -------------------------------------------------------
+function el(tag, text, cls) {
+  const e = document.createElement(tag);
+  if (text !== undefined) e.textContent = text;
+  if (cls) e.className = cls;
+  return e;
+}
+
+function showLegend(j) {
+  const box = $('legend');
+  box.replaceChildren();
+  if (j.legend) {
+    const counts = j.comparison.visibility.mismatches;
+    for (const entry of j.legend) {
+      const item = el('span', '', 'legend-item');
+      const swatch = el('span', '', 'swatch');
+      swatch.style.background = entry.color;
+      item.append(swatch, entry.label + (entry.key in counts ? ' (' + counts[entry.key] + ')' : ''));
+      box.append(item);
+    }
+  } else if (j.colorBar) {
+    const bar = el('span', '', 'colorbar');
+    bar.style.background = j.colorBar.gradient;
+    const missing = el('span', '', 'swatch');
+    missing.style.background = j.colorBar.missing;
+    box.append(el('span', j.colorBar.quantity + ': ' + fmt(j.colorBar.lo) + ' '), bar,
+               el('span', ' ' + fmt(j.colorBar.hi) + '  '), missing, el('span', ' no value'));
+  }
+}
+
+function table(rows, head) {
+  const t = el('table');
+  if (head) {
+    const tr = el('tr');
+    for (const h of head) tr.append(el('th', h));
+    t.append(tr);
+  }
+  for (const row of rows) {
+    const tr = el('tr');
+    for (const cell of row) tr.append(cell instanceof Node ? cell : el('td', String(cell)));
+    t.append(tr);
+  }
+  return t;
+}
+
+function workOf(render) {
+  const box = el('details');
+  box.open = true;
+  box.append(el('summary', render.renderer + ': ' + (render.seconds * 1000).toFixed(1) + ' ms' +
+                (render.preparation ? ' (BVH ' + render.preparation + ')' : '')));
+  const left = el('ul', '', 'left-out');
+  for (const p of render.passesLeftOut) left.append(el('li', p));
+  const run = el('ul', '', 'passes-run');
+  for (const p of render.passesRun) run.append(el('li', p));
+  box.append(el('h3', 'left out'), left, el('h3', 'passes run'), run);
+  const counters = Object.entries(render.counters).filter(([, v]) => v !== 0);
+  box.append(el('h3', 'counters (non-zero)'), table(counters.map(([k, v]) => [k, v.toLocaleString('en')])));
+  box.append(el('h3', 'timings'), table(Object.entries(render.timings).map(([k, v]) => [k, (v * 1000).toFixed(2) + ' ms'])));
+  return box;
+}
+
+function showWork(a, b) {
+  const body = $('work-body');
+  body.replaceChildren();
+  if (a.comparison) {
+    const v = a.comparison.visibility;
+    const c = a.comparison.color;
+    const classes = Object.entries(v.mismatches).filter(([, n]) => n > 0).map(([k, n]) => k + ' ' + n).join(', ');
+    body.append(el('p', a.comparison.pair.join(' vs ') + ': ' + (v.agreement * 100).toFixed(4) + '% of ' +
+                        v.compared.toLocaleString('en') + ' layers agree' + (classes ? '; ' + classes : '') +
+                        (v.cutOff ? '; cut off ' + v.cutOff : '') + '. Colour RMS ' + c.rms.toPrecision(3) +
+                        (c.psnr >= 0 ? ', PSNR ' + c.psnr.toFixed(1) + ' dB' : ', identical') + '.', 'summary'));
+  }
+  for (const r of a.renders.concat(b ? b.renders : [])) body.append(workOf(r));
+}
+
+// ---- pixel inspection -------------------------------------------------------
+let explainAbort = null;
+let explainShown = null; // resolves the selftest's wait
+const SVG = 'http://www.w3.org/2000/svg';
+
+function clearExplain() {
+  explainedPixel = null;
+  $('overlay').replaceChildren();
+  $('explain-body').replaceChildren();
+  $('explain-hint').hidden = false;
+}
+
+async function explainPixel(x, y) {
+  if (explainAbort) explainAbort.abort();
+  const ctl = new AbortController();
+  explainAbort = ctl;
+  const q = renderQuery(true);
+  q.set('x', String(x));
+  q.set('y', String(y));
+  q.set('client', client + '-explain');
+  q.set('seq', String(++seq));
+  setStatus('explaining pixel (' + x + ', ' + y + ')…');
+  try {
+    const j = await getJson('/api/explain?' + q.toString(), ctl.signal);
+    explainedPixel = [x, y];
+    showExplain(j);
+    drawRays(j.rays, x, y);
+    setStatus('pixel (' + x + ', ' + y + ')');
+    if (explainShown) explainShown(j);
+  } catch (e) {
+    if (e.name !== 'AbortError') {
+      setStatus(e.message, true);
+      failSelftest('explain: ' + e.message);
+    }
+  }
+}
+
+function hitText(h) {
+  return h ? '(' + h.instance + ', ' + h.triangle + ') Z ' + Number(h.depth).toPrecision(7) : 'nothing';
+}
+
+function hitsTable(samples) {
+  const rows = [];
+  for (const s of samples) {
+    s.layers.forEach((layer, k) => {
+      const verdict = el('td', layer.verdict, layer.verdict === 'agree' ? 'agree' : 'mismatch');
+      rows.push([k === 0 ? s.sample + ' (' + s.position.map((p) => p.toFixed(3)).join(', ') + ')' : '',
+                 k, hitText(layer.raster), hitText(layer.raytrace), verdict]);
+    });
+  }
+  return table(rows, ['sample', 'layer', 'raster', 'raytrace', 'verdict']);
+}
+
+function rayTree(events) {
+  const list = el('ul', '', 'ray-tree');
+  for (const e of events.filter((ev) => ev.stage === 'ray')) {
+    const v = e.values;
+    const where = e.instance !== null ? ' (' + e.instance + ', ' + e.triangle + ')' : '';
+    const li = el('li', (e.sample !== null ? 's' + e.sample + ' ' : '') + v.kind + ' → ' + e.outcome + where +
+                        (v.t ? ' t ' + v.t : '') + ' ' + (v.contribution || v.transmittance || ''), 'ray-' + v.kind);
+    li.style.paddingLeft = (e.depth * 1.2) + 'em';
+    list.append(li);
+  }
+  return list;
+}
+
+function showExplain(j) {
+  const e = j.explain;
+  const body = $('explain-body');
+  $('explain-hint').hidden = true;
+  body.replaceChildren(el('p', 'pixel (' + e.pixel.join(', ') + ') of ' + e.size.join('×') + ', ' + e.spp + ' spp'),
+                       el('code', j.command, 'command-small'));
+  body.append(el('h3', 'hits per sample'), hitsTable(e.samples));
+  const rays = e.raytrace.events.filter((ev) => ev.stage === 'ray').length;
+  body.append(el('h3', 'ray tree (' + rays + ' rays)'), rayTree(e.raytrace.events));
+  const text = el('details');
+  text.append(el('summary', 'full explain output (rasterizer: ' + e.raster.events.length + ' events)'), el('pre', j.text));
+  body.append(text);
+  body.append(el('div', 'explained', 'explain-done'));
+}
+
+function drawRays(rays, x, y) {
+  const svg = $('overlay');
+  svg.replaceChildren();
+  // The pixel, and a ring around it that stays visible on a large image.
+  const radius = Math.max(4, lastFrame.width / 60);
+  const mark = document.createElementNS(SVG, 'rect');
+  for (const [k, v] of [['x', x], ['y', y], ['width', 1], ['height', 1], ['class', 'pixel-mark']]) mark.setAttribute(k, v);
+  const ring = document.createElementNS(SVG, 'circle');
+  for (const [k, v] of [['cx', x + 0.5], ['cy', y + 0.5], ['r', radius], ['class', 'pixel-mark']]) ring.setAttribute(k, v);
+  svg.append(mark, ring);
+  for (const r of rays) {
+    if (r.kind === 'primary') {
+      const dot = document.createElementNS(SVG, 'circle');
+      for (const [k, v] of [['cx', r.to[0]], ['cy', r.to[1]], ['r', 0.8], ['class', 'ray ray-primary']]) dot.setAttribute(k, v);
+      svg.append(dot);
+      continue;
+    }
+    const line = document.createElementNS(SVG, 'line');
+    const attrs = [['x1', r.from[0]], ['y1', r.from[1]], ['x2', r.to[0]], ['y2', r.to[1]],
+                   ['class', 'ray ray-' + r.kind + ' ' + r.outcome]];
+    for (const [k, v] of attrs) line.setAttribute(k, v);
+    const title = document.createElementNS(SVG, 'title');
+    title.textContent = 'sample ' + r.sample + ': ' + r.kind + ' ray, ' + r.outcome;
+    line.append(title);
+    svg.append(line);
+  }
+}
+
+// ---- camera: orbit, pan, zoom ----------------------------------------------
+function currentCamera() {
+  if (state.camera) return state.camera;
+  const c = state.sceneInfo.camera;
+  return {eye: c.eye.slice(), target: c.target.slice(), up: c.up.slice()};
+}
+
+function orbit(dx, dy) {
+  const cam = currentCamera();
+  const up = norm(cam.up);
+  let offset = sub(cam.eye, cam.target);
+  offset = rotate(offset, up, -dx * 0.01);
+  const right = norm(cross(up, offset));
+  const turned = rotate(offset, right, -dy * 0.01);
+  // Stop short of the poles, where up and the view direction align.
+  const cosine = dot(norm(turned), up);
+  if (Math.abs(cosine) < 0.995) offset = turned;
+  state.camera = {eye: add(cam.target, offset), target: cam.target, up: cam.up};
+}
+
+function pan(dx, dy) {
+  const cam = currentCamera();
+  const forward = norm(sub(cam.target, cam.eye));
+  const right = norm(cross(forward, cam.up));
+  const up = cross(right, forward);
+  const distance = Math.hypot(...sub(cam.eye, cam.target));
+  const yfov = (state.sceneInfo.camera.yfovDegrees || 45) * Math.PI / 180;
+  const perPixel = 2 * distance * Math.tan(yfov / 2) / $('image-a').getBoundingClientRect().height;
+  const move = add(mul(right, -dx * perPixel), mul(up, dy * perPixel));
+  state.camera = {eye: add(cam.eye, move), target: add(cam.target, move), up: cam.up};
+}
+
+function zoom(steps) {
+  const cam = currentCamera();
+  const offset = mul(sub(cam.eye, cam.target), Math.pow(1.1, steps));
+  state.camera = {eye: add(cam.target, offset), target: cam.target, up: cam.up};
+}
+
+// The image pixel under a mouse event, or null outside the image.
+function pixelAt(ev) {
+  const rect = $('image-a').getBoundingClientRect();
+  if (!lastFrame || rect.width === 0) return null;
+  const x = Math.floor((ev.clientX - rect.left) / rect.width * lastFrame.width);
+  const y = Math.floor((ev.clientY - rect.top) / rect.height * lastFrame.height);
+  if (x < 0 || y < 0 || x >= lastFrame.width || y >= lastFrame.height) return null;
+  return [x, y];
+}
+
+let press = null;
+function onMouseDown(ev) {
+  ev.preventDefault();
+  press = {x: ev.clientX, y: ev.clientY, lastX: ev.clientX, lastY: ev.clientY,
+           pan: ev.button === 2 || ev.button === 1 || ev.shiftKey};
+}
+
+function onMouseMove(ev) {
+  if (!press) return;
+  const dx = ev.clientX - press.lastX, dy = ev.clientY - press.lastY;
+  if (!dragging && Math.hypot(ev.clientX - press.x, ev.clientY - press.y) < 4) return;
+  dragging = true;
+  press.lastX = ev.clientX;
+  press.lastY = ev.clientY;
+  if (press.pan) pan(dx, dy); else orbit(dx, dy);
+  cameraMoved();
+  requestFrame(true);
+}
+
+function onMouseUp(ev) {
+  if (!press) return;
+  const wasDrag = dragging;
+  dragging = false;
+  press = null;
+  if (wasDrag) { requestFrame(false); return; }
+  const p = pixelAt(ev);
+  if (p) explainPixel(p[0], p[1]);
+}
+
+let wheelTimer = null;
+function onWheel(ev) {
+  ev.preventDefault();
+  zoom(ev.deltaY > 0 ? 1 : -1);
+  cameraMoved();
+  dragging = true;
+  requestFrame(true);
+  clearTimeout(wheelTimer);
+  wheelTimer = setTimeout(() => { dragging = false; requestFrame(false); }, 350);
+}
+
+function cameraMoved() {
+  $('camera-pick').value = 'moved';
+  clearExplain();
+}
+
+// ---- controls -----------------------------------------------------------------
+function controls() { return Array.from(document.querySelectorAll('[data-option]')); }
+function optionInfo(name) { return optionTable.find((o) => o.name === name); }
+
+// The settings the controls show, leaving out every value equal to the
+// command's default: the command line then holds only what differs.
+function readControls() {
+  const o = {};
+  // Options the page has no control for (from the URL) stay as given.
+  for (const [k, v] of Object.entries(state.options)) if (!controls().some((c) => c.dataset.option === k)) o[k] = v;
+  for (const c of controls()) {
+    const name = c.dataset.option;
+    if (name === 'shadow-bias') continue;
+    if (c.type === 'checkbox') { if (c.checked) o[name] = 'on'; continue; }
+    o[name] = name === 'transparency' && c.value === 'peel' ? 'peel:' + $('peel-layers').value : c.value;
+  }
+  const bias = controls().filter((c) => c.dataset.option === 'shadow-bias').map((c) => c.value);
+  if (bias.every((v) => v !== '')) o['shadow-bias'] = bias.join(',');
+  if (!$('secondary').checked) o['max-depth'] = '0';
+  for (const [k, v] of Object.entries(o)) {
+    const info = optionInfo(k);
+    if (v === '' || (info && info.default === v)) delete o[k];
+  }
+  state.options = o;
+  state.size = [Number($('width').value), Number($('height').value)];
+}
+
+function writeControls() {
+  for (const c of controls()) {
+    const name = c.dataset.option;
+    const info = optionInfo(name);
+    const value = state.options[name] !== undefined ? state.options[name] : (info ? info.default : '');
+    if (c.type === 'checkbox') c.checked = value === 'on';
+    else if (name === 'shadow-bias') c.value = value ? value.split(',')[Number(c.dataset.index)] || '' : '';
+    else if (name === 'transparency' && value.startsWith('peel:')) { c.value = 'peel'; $('peel-layers').value = value.slice(5); }
+    else if (c.tagName === 'INPUT') c.value = value;
+    else if (value !== '' || name === 'shadows') c.value = value;
+  }
+  $('secondary').checked = state.options['max-depth'] !== '0';
+  $('width').value = state.size[0];
+  $('height').value = state.size[1];
+  for (const id of ['renderer', 'view', 'pair']) $(id).value = state[id];
+  $('swipe-with').value = state.swipeWith;
+}
+
+// Greys out what does not apply to the chosen renderer or view (the server
+// would refuse it, as `rastray render` does) and says where it applies.
+function updateApplicability() {
+  const all = state.view !== 'image' && state.view !== 'swipe';
+  const renderers = all ? [null] : state.view === 'swipe' ? [state.renderer, state.swipeWith] : [state.renderer];
+  for (const c of controls()) {
+    const info = optionInfo(c.dataset.option);
+    const ok = !!info && renderers.some((r) => applies(info, all, r));
+    c.disabled = !ok;
+    c.closest('label').classList.toggle('na', !ok);
+    c.closest('label').title = info ? info.help + (ok ? '' : ' (applies to ' + info.applies + ')') : '';
+  }
+  for (const opt of document.querySelectorAll('[data-option="shadows"] option')) {
+    opt.disabled = !all && opt.value !== '' && !renderers.every((r) => shadowsValid(opt.value, r));
+  }
+  $('peel-layers').hidden = state.options.transparency === undefined || !state.options.transparency.startsWith('peel');
+  if (!$('secondary').checked) document.querySelector('[data-option="max-depth"]').disabled = true;
+  $('renderer-label').hidden = all;
+  $('swipe-label').hidden = state.view !== 'swipe';
+  $('pair-label').hidden = !all;
+}
+
+function settingsChanged() {
+  readControls();
+  state.renderer = $('renderer').value;
+  state.view = $('view').value;
+  state.pair = $('pair').value;
+  state.swipeWith = $('swipe-with').value;
+  updateApplicability();
+  clearExplain();
+  requestFrame(false);
+}
+
+// The page's state as its own URL, so a view can be bookmarked or shared.
+function rememberInUrl() {
+  const all = state.view !== 'image' && state.view !== 'swipe';
+  const q = renderQuery(all, state.renderer);
+  if (!all) q.delete('renderer');
+  q.set('renderer', state.renderer);
+  q.set('view', state.view);
+  if (all) q.set('pair', state.pair);
+  if (state.view === 'swipe') q.set('swipe', state.swipeWith);
+  history.replaceState(null, '', '?' + q.toString());
+}
+
+function readUrl(params, scenes) {
+  state.scene = scenes.includes(params.get('scene')) ? params.get('scene') : scenes[0] || '';
+  for (const k of ['renderer', 'view', 'pair']) if (params.get(k)) state[k] = params.get(k);
+  if (params.get('swipe')) state.swipeWith = params.get('swipe');
+  if (params.get('size')) state.size = params.get('size').split(',').map(Number);
+  if (params.get('eye') && params.get('target') && params.get('up')) {
+    const vec = (k) => params.get(k).split(',').map(Number);
+    state.camera = {eye: vec('eye'), target: vec('target'), up: vec('up')};
+  }
+  for (const info of optionTable) {
+    if (params.has(info.name) && !['size', 'eye', 'target', 'up'].includes(info.name)) {
+      state.options[info.name] = params.get(info.name);
+    }
+  }
+}
+
+async function loadScene(keepCamera) {
+  const q = new URLSearchParams({scene: state.scene, size: state.size.join(',')});
+  state.sceneInfo = await getJson('/api/scene?' + q.toString());
+  if (!keepCamera) state.camera = null;
+  const pick = $('camera-pick');
+  pick.replaceChildren(new Option('scene camera: ' + state.sceneInfo.camera.origin, 'scene'),
+                       new Option('moved (drag, pan, zoom)', 'moved'));
+  pick.value = state.camera ? 'moved' : 'scene';
+}
+
+function bindEvents() {
+  for (const c of controls().concat([$('secondary'), $('peel-layers'), $('width'), $('height'), $('renderer'),
+                                      $('view'), $('pair'), $('swipe-with')])) {
+    c.addEventListener('change', settingsChanged);
+  }
+  $('scene').addEventListener('change', async () => {
+    state.scene = $('scene').value;
+    clearExplain();
+    await loadScene(false);
+    requestFrame(false);
+  });
+  $('camera-pick').addEventListener('change', () => {
+    if ($('camera-pick').value === 'scene') { state.camera = null; clearExplain(); requestFrame(false); }
+  });
+  $('swipe').addEventListener('input', applySwipe);
+  $('copy').addEventListener('click', () => navigator.clipboard.writeText($('command').textContent));
+  const stage = $('stage');
+  stage.addEventListener('mousedown', onMouseDown);
+  stage.addEventListener('contextmenu', (ev) => ev.preventDefault());
+  stage.addEventListener('wheel', onWheel, {passive: false});
+  window.addEventListener('mousemove', onMouseMove);
+  window.addEventListener('mouseup', onMouseUp);
+}
+
+// ---- self test (?selftest=click:X,Y) --------------------------------------
+// For the headless-browser test and the README screenshot: after the first
+// image, click pixel (X, Y) through the same mouse handlers a user's click
+// reaches, wait for the explain panel, and report in #selftest-result.
+let selftestOn = false;
+function failSelftest(message) {
+  if (!selftestOn) return;
+  const r = $('selftest-result');
+  if (r.dataset.status) return;
+  r.dataset.status = 'fail';
+  r.textContent = 'selftest failed: ' + message;
+  r.hidden = false;
+}
+
+// A whole-number client coordinate (mouse events carry integers) inside
+// image pixel `p` along `axis`.
+function clientCoordinate(axis, p) {
+  const rect = $('image-a').getBoundingClientRect();
+  const start = axis === 'x' ? rect.left : rect.top;
+  const scale = (axis === 'x' ? rect.width / lastFrame.width : rect.height / lastFrame.height);
+  const target = start + (p + 0.5) * scale;
+  for (const c of [Math.floor(target), Math.ceil(target)]) {
+    if (Math.floor((c - start) / scale) === p) return c;
+  }
+  return target;
+}
+
+async function runSelftest(spec) {
+  selftestOn = true;
+  const m = /^click:(\d+),(\d+)$/.exec(spec);
+  if (!m) { failSelftest('unknown selftest ' + spec); return; }
+  const timer = setTimeout(() => failSelftest('timed out'), 60000);
+  await firstFrame;
+  const explained = new Promise((resolve) => { explainShown = resolve; });
+  const at = {clientX: clientCoordinate('x', Number(m[1])), clientY: clientCoordinate('y', Number(m[2])),
+              button: 0, bubbles: true};
+  $('stage').dispatchEvent(new MouseEvent('mousedown', at));
+  $('stage').dispatchEvent(new MouseEvent('mouseup', at));
+  const j = await explained;
+  clearTimeout(timer);
+  const r = $('selftest-result');
+  if (r.dataset.status) return;
+  const panel = $('explain-body');
+  const ok = panel.querySelector('.explain-done') && j.explain.samples.length > 0;
+  r.dataset.status = ok ? 'ok' : 'fail';
+  r.textContent = 'selftest ' + (ok ? 'ok' : 'failed') + ': pixel (' + j.explain.pixel.join(', ') + '), ' +
+                  j.explain.samples.length + ' samples, ' + $('overlay').querySelectorAll('.ray').length +
+                  ' rays drawn';
+}
+
+// ---- start --------------------------------------------------------------------
+async function init() {
+  const params = new URLSearchParams(location.search);
+  try {
+    const [opts, scenes] = await Promise.all([getJson('/api/options'), getJson('/api/scenes')]);
+    optionTable = opts.options;
+    const spp = document.querySelector('[data-option="spp"]');
+    for (const n of opts.sppValues) spp.append(new Option(String(n), String(n)));
+    for (const s of scenes.scenes) $('scene').append(new Option(s, s));
+    readUrl(params, scenes.scenes);
+    $('scene').value = state.scene;
+    writeControls();
+    bindEvents();
+    updateApplicability();
+    if (params.get('selftest')) runSelftest(params.get('selftest'));
+    if (!state.scene) { setStatus('no scene: start rastray serve with a scene or --root', true); return; }
+    await loadScene(!!state.camera);
+    readControls();
+    requestFrame(false);
+  } catch (e) {
+    setStatus(e.message, true);
+    failSelftest('start: ' + e.message);
+  }
+}
+
+init();
