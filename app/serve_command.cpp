@@ -1,8 +1,5 @@
 // `rastray serve SCENE... [--port 8080] [--host 127.0.0.1] [--root DIR]`:
 // the browser explorer (app/serve_server.h).
-#include <pthread.h>
-#include <signal.h>
-
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -12,6 +9,7 @@
 #include "app/commands.h"
 #include "app/serve_server.h"
 #include "common/error.h"
+#include "common/interrupt.h"
 
 namespace rastray {
 
@@ -21,22 +19,17 @@ struct ServeCommandOptions {
   serve::ServeOptions server;
 };
 
-// SIGINT and SIGTERM stop the server cleanly. They are blocked in every
-// thread (the server's and TBB's inherit the mask from this one) and taken
-// by one watcher with sigwait(): no signal handler runs at all, so nothing
-// has to be async-signal-safe, and the watcher may call Server::stop().
-class SignalWatcher {
+// SIGINT and SIGTERM stop the server cleanly, through the handlers every
+// long-running command installs (common/interrupt.h: they only record the
+// signal). This watcher polls the record and stops the server; a render
+// under way stops at its next tile (the renderers poll the same record),
+// and a second Ctrl-C ends the process at once.
+class InterruptWatcher {
  public:
-  explicit SignalWatcher(serve::ExplorerServer& server) {
-    sigemptyset(&signals_);
-    sigaddset(&signals_, SIGINT);
-    sigaddset(&signals_, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &signals_, &previous_);
+  explicit InterruptWatcher(serve::ExplorerServer& server) {
+    installInterruptHandlers();
     thread_ = std::thread([this, &server] {
-      int signal = 0;
-      sigwait(&signals_, &signal);
-      if (done_) return;
-      std::fprintf(stderr, "rastray serve: %s, stopping\n", signal == SIGINT ? "interrupted" : "terminated");
+      while (!done_ && !interruptRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
       // Server::stop() does nothing before the server's loop has started
       // (a signal just after the address was printed): repeat it until
       // run() has returned.
@@ -46,17 +39,12 @@ class SignalWatcher {
       }
     });
   }
-  // Ends the watcher once the server has stopped: wakes it from sigwait()
-  // when no signal came, or ends its stop() loop.
-  ~SignalWatcher() {
+  ~InterruptWatcher() {
     done_ = true;
-    pthread_kill(thread_.native_handle(), SIGTERM);  // blocked here: only sigwait() takes it
     thread_.join();
-    pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
   }
 
  private:
-  sigset_t signals_, previous_;
   std::atomic<bool> done_{false};
   std::thread thread_;
 };
@@ -65,20 +53,26 @@ int runServe(ServeCommandOptions& opt) {
   if (opt.server.scenes.empty() && opt.server.root.empty())
     throw InputError("command line", "SCENE", "name at least one scene, or a --root directory");
   serve::ExplorerServer server(opt.server);
-  // Block the signals before the server starts its threads.
-  SignalWatcher watcher(server);
-  const int port = server.bind();
-  const bool local =
-      opt.server.host == "127.0.0.1" || opt.server.host == "localhost" || opt.server.host == "::1";
-  if (!local)
-    std::fprintf(stderr,
-                 "rastray serve: listening on %s: anyone who can reach this address can render the scenes\n",
-                 opt.server.host.c_str());
-  const std::string host =
-      opt.server.host.find(':') != std::string::npos ? "[" + opt.server.host + "]" : opt.server.host;
-  std::printf("rastray serve: http://%s:%d/ (Ctrl-C stops)\n", host.c_str(), port);
-  std::fflush(stdout);
-  const bool ok = server.run();
+  bool ok = false;
+  {
+    // Before the address is printed: from then on a signal stops the server.
+    InterruptWatcher watcher(server);
+    const int port = server.bind();
+    const bool local =
+        opt.server.host == "127.0.0.1" || opt.server.host == "localhost" || opt.server.host == "::1";
+    if (!local)
+      std::fprintf(
+          stderr, "rastray serve: listening on %s: anyone who can reach this address can render the scenes\n",
+          opt.server.host.c_str());
+    const std::string host =
+        opt.server.host.find(':') != std::string::npos ? "[" + opt.server.host + "]" : opt.server.host;
+    std::printf("rastray serve: http://%s:%d/ (Ctrl-C stops)\n", host.c_str(), port);
+    std::fflush(stdout);
+    ok = server.run();
+  }
+  // Stopped by a signal: the exit status every command gives (130, 143).
+  if (interruptRequested())
+    throw Interrupted(interruptSignal(), "the server stopped, nothing left unfinished");
   return ok ? 0 : 2;
 }
 

@@ -155,11 +155,12 @@ TEST(ServeBrowser, PageShowsTheImageAndExplainsAClickedPixel) {
   EXPECT_NE(
       html.find("rastray render " + scenePath("cornell-box") + " --renderer raytrace --size 160 120 --spp 4"),
       std::string::npos);
-  EXPECT_EQ(server.stop(SIGTERM), 0) << server.err();
+  EXPECT_EQ(server.stop(SIGTERM), 128 + SIGTERM) << server.err();
   fs::remove_all(dir);
 }
 
-// Ctrl-C or SIGTERM stop the server: exit status 0, and its scratch
+// Ctrl-C or SIGTERM stop the server: the exit status of every command a
+// signal stopped (128 + signal, common/interrupt.h), and its scratch
 // directory (in TMPDIR) is gone, so it shut down through its destructors.
 TEST(ServeProcess, StopsCleanlyOnSigintAndSigterm) {
   for (const int signal : {SIGINT, SIGTERM}) {
@@ -167,8 +168,9 @@ TEST(ServeProcess, StopsCleanlyOnSigintAndSigterm) {
     ServeProcess server({scenePath("three-triangles")}, dir);
     ASSERT_GT(server.port(), 0) << server.err();
     EXPECT_FALSE(fs::is_empty(dir / "tmp"));  // the scratch directory exists while it runs
-    EXPECT_EQ(server.stop(signal), 0) << server.err();
-    EXPECT_NE(server.err().find(signal == SIGINT ? "interrupted, stopping" : "terminated, stopping"),
+    EXPECT_EQ(server.stop(signal), 128 + signal) << server.err();
+    EXPECT_NE(server.err().find(signal == SIGINT ? "interrupted by SIGINT: the server stopped"
+                                                 : "interrupted by SIGTERM: the server stopped"),
               std::string::npos)
         << server.err();
     EXPECT_TRUE(fs::is_empty(dir / "tmp"));
