@@ -11,6 +11,7 @@
 #include <tbb/global_control.h>
 
 #include "app/sweep_table.h"
+#include "common/memory_budget.h"
 
 namespace rastray {
 
@@ -24,12 +25,6 @@ double processCpuSeconds() {
   timespec t{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-uint64_t peakRssBytes() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return uint64_t(usage.ru_maxrss) * 1024;  // Linux reports KiB
 }
 
 nlohmann::json spreadJson(const Spread& s) {

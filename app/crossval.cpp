@@ -1,5 +1,6 @@
 #include "app/crossval.h"
 
+#include "app/memory_estimate.h"
 #include "common/interrupt.h"
 #include "compare/classify.h"
 
@@ -27,6 +28,12 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
     if (progress) progress(line);
   };
 
+  // Three deep frames are kept until they are compared: refused up front
+  // when they would not fit, not after the first two.
+  checkMemory(estimateCrossvalMemory(scene, settings), settings.memory, scene.path, "",
+              "cross-validating " + std::to_string(settings.camera.width()) + "x" +
+                  std::to_string(settings.camera.height()) + " at " + std::to_string(settings.spp) +
+                  " spp (three deep frames)");
   RenderSettings s = settings;
   s.keepSamples = true;
   s.renderer = RendererKind::Raster;

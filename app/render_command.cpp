@@ -9,6 +9,7 @@
 
 #include "app/cli_options.h"
 #include "app/commands.h"
+#include "app/memory_estimate.h"
 #include "app/render_setup.h"
 #include "common/error.h"
 #include "common/image.h"
@@ -56,7 +57,16 @@ int runRender(RenderCommandOptions& opt) {
   throwIfInterrupted();
   RenderSettings settings = opt.settings;
   settings.keepSamples = opt.deep;
-  const RenderRun run = renderScene(scene, settings);
+  // Before anything large is allocated: the frame and the encoder's
+  // buffers for the file -o names, against --max-memory.
+  const MemoryEstimate memory = estimateRenderCommandMemory(scene, settings,
+                                                            opt.deep       ? OutputFormat::DeepExr
+                                                            : ext == "png" ? OutputFormat::Png
+                                                                           : OutputFormat::Exr);
+  checkMemory(memory, settings.memory, scene.path, "",
+              describeRenderWork(settings, toString(settings.renderer)));
+  RenderRun run = renderScene(scene, settings);
+  run.memoryEstimate = memory;  // what --json and --stats report: the command's whole estimate
   // The last check: a write that has begun finishes (and renames its
   // temporary file into place) even if a signal arrives during it.
   throwIfInterrupted();

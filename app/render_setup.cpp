@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iterator>
 
+#include "app/memory_estimate.h"
 #include "common/error.h"
 #include "common/sampling.h"
 #include "common/trace.h"
@@ -101,6 +102,10 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
     {"--debug-pixel", kAllRenderers, OptionCondition::Always,
      "Trace what each stage did at pixel X Y (stderr)",
      RASTRAY_BIND(cmd.add_option(name, s.debugPixelXY, help)->expected(2))},
+    {"--max-memory", kAllRenderers, OptionCondition::Always,
+     "Refuse (exit 2) work whose estimated peak memory exceeds this: bytes or K, M, G, T (default: 80% "
+     "of physical memory)",
+     RASTRAY_BIND(cmd.add_option(name, s.maxMemory, help))},
     {"--texture-filter", kAllRenderers, OptionCondition::Always,
      "sampler (as the file says), nearest, bilinear or trilinear",
      RASTRAY_BIND(cmd.add_option(name, s.textureFilter, help)->capture_default_str())},
@@ -245,6 +250,7 @@ void RenderSettings::finish() {
       "--ray-offset", rayOffset,
       {{"error-bound", RayOffsetMethod::ErrorBound}, {"float-ulps", RayOffsetMethod::FloatUlps}});
   if (!debugPixelXY.empty()) debugPixel = glm::ivec2(debugPixelXY[0], debugPixelXY[1]);
+  memory = maxMemory.empty() ? MemoryBudget::machineDefault() : MemoryBudget::parse(maxMemory);
 
   raster.spp = spp;
   raster.cull = pick<CullMode>(
@@ -333,7 +339,7 @@ void RenderSettings::finish() {
 }
 
 Scene loadSceneForRender(const std::string& path, const RenderSettings& settings) {
-  Scene scene = loadScene(path);
+  Scene scene = loadScene(path, settings.memory);
   applyRenderOrigin(scene, settings.renderOrigin, settings.camera.overrides());
   return scene;
 }
@@ -398,6 +404,8 @@ RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
   if (s.debugPixel && !raster.trace.sink) raster.trace = {&rasterTrace, *s.debugPixel};
   TraceLog rayTrace;  // the ray caster's ray tree, likewise (--renderer raytrace)
   if (s.debugPixel && !ray.trace.sink) ray.trace = {&rayTrace, *s.debugPixel};
+  const MemoryEstimate memory = estimateRenderMemory(scene, s);
+  checkMemory(memory, s.memory, scene.path, "", describeRenderWork(s, toString(s.renderer)));
 
   const auto start = std::chrono::steady_clock::now();
   FrameRenderer renderer(scene, s, raster, ray);
@@ -410,6 +418,7 @@ RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
   if (renderer.bvhBuildSeconds() >= 0.0)
     run.output.timings.insert(run.output.timings.begin(), {"raytrace.bvh_build", renderer.bvhBuildSeconds()});
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.memoryEstimate = memory;
   if (raster.trace.sink == &rasterTrace) std::fputs(rasterTrace.text().c_str(), stderr);
   if (ray.trace.sink == &rayTrace) std::fputs(rayTreeText(rayTrace.events(), *s.debugPixel).c_str(), stderr);
   return run;
@@ -433,6 +442,14 @@ nlohmann::json renderReportJson(const Scene& scene, const RenderSettings& s, con
   j["timings"] = timings;
   j["passesRun"] = run.output.passesRun;
   j["passesLeftOut"] = run.output.passesLeftOut;
+  // The estimate checked against --max-memory before rendering, and the
+  // process's measured peak so far (this render and what came before it).
+  nlohmann::json parts = nlohmann::json::object();
+  for (const auto& [name, bytes] : run.memoryEstimate.parts()) parts[name] = bytes;
+  j["memory"] = {{"estimatedPeakBytes", run.memoryEstimate.total()},
+                 {"estimatedParts", parts},
+                 {"measuredPeakBytes", peakRssBytes()},
+                 {"limitBytes", s.memory.bytes}};
   return j;
 }
 
@@ -448,6 +465,9 @@ void printRenderStats(const RenderRun& run) {
   for (const std::string& p : run.output.passesRun) std::printf("  %s\n", p.c_str());
   std::printf("left out:\n");
   for (const std::string& p : run.output.passesLeftOut) std::printf("  %s\n", p.c_str());
+  std::printf("\nmemory: estimated peak %s (%s); measured peak %s\n",
+              formatBytes(run.memoryEstimate.total()).c_str(), run.memoryEstimate.largest(3).c_str(),
+              formatBytes(peakRssBytes()).c_str());
 }
 
 }  // namespace rastray

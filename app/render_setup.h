@@ -16,6 +16,7 @@
 #include "common/analysis.h"
 #include "common/camera.h"
 #include "common/gltf/loader.h"
+#include "common/memory_budget.h"
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "common/trace.h"
@@ -80,6 +81,8 @@ struct RenderSettings {
   RenderOrigin renderOrigin = RenderOrigin::Camera;
   std::vector<float> polygonOffset, shadowBias;
   std::vector<int> debugPixelXY;
+  std::string maxMemory;  // empty: MemoryBudget::machineDefault()
+  MemoryBudget memory;    // set by finish(); loads and renders are refused above it
 
   // Set by addRenderSettings: each table row's CLI option (its count()
   // tells whether the user gave it), and whether the command runs every
@@ -144,6 +147,7 @@ struct RenderRun {
   SceneAnalysis analysis;
   RenderOutput output;
   double seconds = 0.0;
+  MemoryEstimate memoryEstimate;  // checked against RenderSettings::memory before rendering
 };
 
 // Loads a scene and rebases it on the render origin --origin names
@@ -151,6 +155,8 @@ struct RenderRun {
 Scene loadSceneForRender(const std::string& path, const RenderSettings& settings);
 
 // Runs the chosen renderer; settings.finish() must have been called.
+// Refuses (InputError, exit 2) before allocating when the estimated peak
+// memory (app/memory_estimate.h) exceeds settings.memory.
 // With settings.debugPixel, what the renderer recorded at that pixel is
 // printed to stderr afterwards, unless the caller gave the renderer's
 // options a trace sink of its own (explain).

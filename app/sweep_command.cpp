@@ -17,6 +17,7 @@
 #include <tbb/global_control.h>
 
 #include "app/commands.h"
+#include "app/memory_estimate.h"
 #include "app/sweep.h"
 #include "app/sweep_crossover.h"
 #include "app/sweep_report.h"
@@ -160,7 +161,17 @@ int runSweep(const SweepOptions& opt) {
                              std::to_string(c.settings.camera.width()) + "x" +
                              std::to_string(c.settings.camera.height()) + " (--size)");
   }
-  for (const std::string& scene : spec.scenes) loadScene(scene);
+  // Every scene loads, and every cell fits --max-memory, before the first
+  // cell runs: a sweep is not refused hours in.
+  for (const std::string& path : spec.scenes) {
+    const Scene scene =
+        loadScene(path, cells.empty() ? MemoryBudget::machineDefault() : cells.front().settings.memory);
+    for (const sweep::Cell& c : cells)
+      if (c.scene == path)
+        checkMemory(estimateRenderMemory(scene, c.settings), c.settings.memory, path,
+                    "cell " + std::to_string(c.index),
+                    describeRenderWork(c.settings, toString(c.settings.renderer)));
+  }
   createFolder(opt.reportDir);
 
   std::vector<sweep::CellResult> rows;

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 
 #include "common/error.h"
 
@@ -199,9 +200,11 @@ std::string shortened(std::string text) {
   return text;
 }
 
-GltfDocument readGltfDocument(const std::string& path) {
+GltfDocument readGltfDocument(const std::string& path) { return parseGltfDocument(path, readFile(path)); }
+
+GltfDocument parseGltfDocument(const std::string& path, std::vector<uint8_t> bytes) {
   GltfDocument d;
-  d.bytes = readFile(path);
+  d.bytes = std::move(bytes);
   d.context = GltfCheckContext{path, false, 0};
   if (d.bytes.size() >= 4 && readU32(d.bytes, 0) == kGlbMagic)
     readGlbContainer(d);

@@ -26,6 +26,11 @@ struct GltfDocument {
 // "nodes"[3], with line and column) on the first problem.
 GltfDocument readGltfDocument(const std::string& path);
 
+// The same for bytes already in memory: `path` is only the name messages
+// use (and, later, the folder resources are resolved in); nothing is read
+// from it here.
+GltfDocument parseGltfDocument(const std::string& path, std::vector<uint8_t> bytes);
+
 // The element name messages use for an entry of a top-level glTF array:
 // "nodes" -> "node", "meshes" -> "mesh"; empty for any other key.
 std::string singular(const std::string& key);

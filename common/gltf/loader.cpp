@@ -12,7 +12,9 @@
 
 #include <filesystem>
 #include <sstream>
+#include <utility>
 
+#include <stb/stb_image.h>
 #include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
 
@@ -20,6 +22,7 @@
 #include "common/gltf/check.h"
 #include "common/gltf/document.h"
 #include "common/gltf/scene_builder.h"
+#include "common/memory_budget.h"
 
 namespace rastray {
 
@@ -55,10 +58,40 @@ bool isResourceFile(const std::string& path, void* user) {
   return std::filesystem::is_regular_file(path, ec);
 }
 
+// Images are decoded by tinygltf (stb); a small PNG can declare a huge
+// canvas. Before each decode, its header's size is added to the decoded
+// total and checked against the budget: 8 bytes per pixel for stb's
+// buffer (up to 16-bit RGBA) plus 4 for the scene's RGBA8 copy.
+struct ImageBudget {
+  const MemoryBudget& budget;
+  uint64_t decodedBytes = 0;
+  int refusedImage = -1;  // the image that would pass the budget
+  MemoryEstimate refusal;
+};
+
+bool loadImageWithinBudget(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
+                           int reqWidth, int reqHeight, const unsigned char* bytes, int size, void* user) {
+  ImageBudget& b = *static_cast<ImageBudget*>(user);
+  int w = 0, h = 0, components = 0;
+  if (stbi_info_from_memory(bytes, size, &w, &h, &components) && w > 0 && h > 0) {
+    b.decodedBytes = addSat(b.decodedBytes, mulSat(mulSat(uint64_t(w), uint64_t(h)), 12));
+    MemoryEstimate estimate;
+    estimate.add("loaded file", currentRssBytes());
+    estimate.add("decoded images", b.decodedBytes);
+    if (estimate.total() > b.budget.bytes) {
+      b.refusedImage = index;
+      b.refusal = estimate;
+      if (err) *err = "image too large for the memory budget";
+      return false;
+    }
+  }
+  return tinygltf::LoadImageData(image, index, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
+}
+
 // Step 3: tinygltf loads the buffers and decodes the images. The document
 // is sound by now, so its remaining failures are about resources: missing
 // files, bad data URIs, undecodable images.
-void loadResources(const GltfDocument& d, tinygltf::Model& model) {
+void loadResources(const GltfDocument& d, tinygltf::Model& model, const MemoryBudget& budget) {
   const std::string& path = d.context.file;
   const std::string baseDir = std::filesystem::path(path).parent_path().string();
   ResourceFolder folder{(baseDir.empty() ? std::string(".") : baseDir) +
@@ -67,6 +100,8 @@ void loadResources(const GltfDocument& d, tinygltf::Model& model) {
   tinygltf::FsCallbacks fs{&isResourceFile, &expandNothing, &tinygltf::ReadWholeFile,
                            &tinygltf::WriteWholeFile, &folder};
   loader.SetFsCallbacks(fs);
+  ImageBudget images{budget};
+  loader.SetImageLoader(&loadImageWithinBudget, &images);
   std::string err, warn;
   if (d.bytes.size() > UINT32_MAX) throw InputError(path, "", "file is larger than 4 GiB");
   const bool ok =
@@ -75,6 +110,9 @@ void loadResources(const GltfDocument& d, tinygltf::Model& model) {
                                         baseDir.empty() ? "." : baseDir)
           : loader.LoadASCIIFromString(&model, &err, &warn, d.jsonText.data(), unsigned(d.jsonText.size()),
                                        baseDir.empty() ? "." : baseDir);
+  if (!ok && images.refusedImage >= 0)
+    checkMemory(images.refusal, budget, path, "image " + std::to_string(images.refusedImage),
+                "decoding the images");
   if (!ok) {
     // tinygltf loads the top-level arrays in this order and appends each
     // entry once it has loaded, so the first array that came up short
@@ -112,12 +150,26 @@ void loadResources(const GltfDocument& d, tinygltf::Model& model) {
 
 }  // namespace
 
-Scene loadScene(const std::string& path) {
-  const GltfDocument document = readGltfDocument(path);
+namespace {
+
+// Steps 2 to 4, the same whichever way the bytes arrived.
+Scene loadDocument(const GltfDocument& document, const MemoryBudget& budget) {
   checkGltfDocument(document.json, document.context);
   tinygltf::Model model;
-  loadResources(document, model);
-  return buildScene(path, document.json, model);
+  loadResources(document, model, budget);
+  return buildScene(document.context.file, document.json, model, budget);
+}
+
+}  // namespace
+
+Scene loadScene(const std::string& path, const MemoryBudget& budget) {
+  return loadDocument(readGltfDocument(path), budget);
+}
+
+Scene loadScene(const std::string& path) { return loadScene(path, MemoryBudget::machineDefault()); }
+
+Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes) {
+  return loadDocument(parseGltfDocument(path, std::move(bytes)), MemoryBudget::machineDefault());
 }
 
 }  // namespace rastray

@@ -7,15 +7,27 @@
 // index ranges, node graph cycles).
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
+#include "common/memory_budget.h"
 #include "common/scene.h"
 
 namespace rastray {
 
 // Loads a .gltf (external or data-URI buffers) or .glb file. Throws
 // InputError naming the file and the element for every kind of bad input
-// (SPEC §7); never returns a partially checked scene.
+// (SPEC §7); never returns a partially checked scene. Decoded images and
+// the flattened store (meshes times the nodes that instance them) are
+// estimated before they are allocated and refused above `budget`.
+Scene loadScene(const std::string& path, const MemoryBudget& budget);
+// With the machine's default budget (MemoryBudget::machineDefault()).
 Scene loadScene(const std::string& path);
+
+// The same for a file's bytes already in memory (the fuzz target's entry;
+// fuzz/gltf_loader_fuzzer.cpp): `path` names the file in messages, and
+// external buffers and images are resolved beside it, as for loadScene.
+Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes);
 
 }  // namespace rastray

@@ -19,6 +19,7 @@
 #include "common/gltf/check.h"
 #include "common/gltf/document.h"
 #include "common/math_constants.h"
+#include "common/memory_budget.h"
 
 namespace rastray {
 
@@ -28,8 +29,9 @@ using json = nlohmann::json;
 
 class SceneBuilder {
  public:
-  SceneBuilder(const std::string& path, const json& doc, const tinygltf::Model& model)
-      : path_(path), doc_(doc), model_(model) {}
+  SceneBuilder(const std::string& path, const json& doc, const tinygltf::Model& model,
+               const MemoryBudget& budget)
+      : path_(path), doc_(doc), model_(model), budget_(budget) {}
 
   Scene build();
 
@@ -51,6 +53,7 @@ class SceneBuilder {
   glm::dmat4 localMatrix(size_t node) const;
   void checkNodeGraph(std::vector<int64_t>& parent) const;
   std::vector<size_t> rootNodes(const std::vector<int64_t>& parent);
+  void reserveFlattenedScene(const std::vector<size_t>& roots);
   void walk(const std::vector<size_t>& roots);
   void addPrimitive(size_t node, size_t mesh, size_t primitive, const glm::dmat4& world);
   // The steps of addPrimitive.
@@ -88,6 +91,7 @@ class SceneBuilder {
   const std::string& path_;
   const json& doc_;
   const tinygltf::Model& model_;
+  const MemoryBudget& budget_;
   Scene scene_;
   int64_t defaultMaterial_ = -1;
 };
@@ -288,6 +292,89 @@ std::vector<size_t> SceneBuilder::rootNodes(const std::vector<int64_t>& parent) 
     }
   }
   return roots;
+}
+
+// Before the walk allocates anything: the flattened totals, from accessor
+// counts summed over every node that instances a mesh. A tiny file can
+// name one large accessor from thousands of nodes or primitives; its
+// scene is refused here, by count (2^32) or by the memory budget, instead
+// of exhausting memory part way through the walk. With the totals known,
+// the store is reserved once, so it never holds two copies while growing.
+void SceneBuilder::reserveFlattenedScene(const std::vector<size_t>& roots) {
+  const json& nodes = array("nodes");
+  const json& accessors = array("accessors");
+  struct MeshTotals {
+    uint64_t vertices = 0, triangles = 0, primitives = 0, largestPrimitive = 0;
+    bool colors = false, counted = false;
+  };
+  std::vector<MeshTotals> meshes(array("meshes").size());
+  const auto totalsOf = [&](size_t mesh) -> const MeshTotals& {
+    MeshTotals& t = meshes[mesh];
+    if (t.counted) return t;
+    t.counted = true;
+    for (const json& prim : array("meshes")[mesh].at("primitives")) {
+      const int64_t mode = get<int64_t>(prim, "mode", 4);
+      const json& attributes = prim.at("attributes");
+      if (mode < 4 || !attributes.contains("POSITION")) continue;
+      const uint64_t v = accessors[attributes.at("POSITION").get<size_t>()].at("count").get<uint64_t>();
+      const uint64_t n = prim.contains("indices")
+                             ? accessors[prim.at("indices").get<size_t>()].at("count").get<uint64_t>()
+                             : v;
+      t.vertices += v;
+      t.triangles += mode == 4 ? n / 3 : (n >= 3 ? n - 2 : 0);
+      t.primitives += 1;
+      t.largestPrimitive = std::max(t.largestPrimitive, std::max(v, n));
+      t.colors = t.colors || attributes.contains("COLOR_0");
+    }
+    return t;
+  };
+  uint64_t vertices = 0, triangles = 0, instances = 0, largestPrimitive = 0;
+  bool colors = false;
+  std::vector<size_t> stack(roots.rbegin(), roots.rend());
+  while (!stack.empty()) {
+    const json& n = nodes[stack.back()];
+    stack.pop_back();
+    if (n.contains("mesh")) {
+      const MeshTotals& t = totalsOf(n.at("mesh").get<size_t>());
+      vertices = addSat(vertices, t.vertices);
+      triangles = addSat(triangles, t.triangles);
+      instances = addSat(instances, t.primitives);
+      largestPrimitive = std::max(largestPrimitive, t.largestPrimitive);
+      colors = colors || t.colors;
+    }
+    if (n.contains("children"))
+      for (const json& c : n.at("children")) stack.push_back(c.get<size_t>());
+  }
+  if (vertices >= kNoId)
+    fail("scene", "the node tree instances meshes into " + std::to_string(vertices) +
+                      " vertices; the scene store holds fewer than 2^32");
+  if (triangles >= kNoId)
+    fail("scene", "the node tree instances meshes into " + std::to_string(triangles) +
+                      " triangles; the scene store holds fewer than 2^32");
+
+  // Bytes per vertex: worldPositions (double), positions, normals,
+  // texcoords, colours when any primitive has them; per triangle its
+  // indices; per instance the Instance; and the largest primitive's
+  // accessors read as doubles while it is flattened (8 components).
+  const uint64_t perVertex =
+      sizeof(glm::dvec3) + sizeof(glm::vec3) * 2 + sizeof(glm::vec2) + (colors ? sizeof(glm::vec4) : 0);
+  MemoryEstimate estimate;
+  estimate.add("loaded file", currentRssBytes());
+  estimate.add("vertices", mulSat(vertices, perVertex));
+  estimate.add("triangles", mulSat(triangles, sizeof(glm::uvec3)));
+  estimate.add("instances", mulSat(instances, sizeof(Instance)));
+  estimate.add("largest primitive", mulSat(largestPrimitive, 8 * sizeof(double) + sizeof(uint32_t)));
+  checkMemory(estimate, budget_, path_, "scene",
+              "flattening " + std::to_string(instances) + " instances into " + std::to_string(vertices) +
+                  " vertices and " + std::to_string(triangles) + " triangles");
+
+  scene_.worldPositions.reserve(vertices);
+  scene_.positions.reserve(vertices);
+  scene_.normals.reserve(vertices);
+  scene_.texcoords.reserve(vertices);
+  if (colors) scene_.colors.reserve(vertices);
+  scene_.triangles.reserve(triangles);
+  scene_.instances.reserve(instances);
 }
 
 void SceneBuilder::walk(const std::vector<size_t>& roots) {
@@ -793,15 +880,18 @@ Scene SceneBuilder::build() {
   loadMaterials();
   std::vector<int64_t> parent;
   checkNodeGraph(parent);
-  walk(rootNodes(parent));
+  const std::vector<size_t> roots = rootNodes(parent);
+  reserveFlattenedScene(roots);
+  walk(roots);
   noteIgnoredFeatures();
   return std::move(scene_);
 }
 
 }  // namespace
 
-Scene buildScene(const std::string& path, const nlohmann::json& doc, const tinygltf::Model& model) {
-  return SceneBuilder(path, doc, model).build();
+Scene buildScene(const std::string& path, const nlohmann::json& doc, const tinygltf::Model& model,
+                 const MemoryBudget& budget) {
+  return SceneBuilder(path, doc, model, budget).build();
 }
 
 }  // namespace rastray

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "common/memory_budget.h"
 #include "common/scene.h"
 
 namespace tinygltf {
@@ -17,7 +18,10 @@ namespace rastray {
 
 // Throws InputError (file: path) for what only the data can show: NaN or
 // infinite values, indices out of range, cycles in the node graph,
-// factors outside [0, 1], images that did not decode.
-Scene buildScene(const std::string& path, const nlohmann::json& doc, const tinygltf::Model& model);
+// factors outside [0, 1], images that did not decode, and a flattened
+// scene (meshes times the nodes instancing them) of 2^32 vertices or
+// triangles or beyond `budget`, counted before anything is allocated.
+Scene buildScene(const std::string& path, const nlohmann::json& doc, const tinygltf::Model& model,
+                 const MemoryBudget& budget);
 
 }  // namespace rastray

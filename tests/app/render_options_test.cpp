@@ -51,6 +51,7 @@ const std::vector<Expected> kExpected = {
     {"--spp", kAllRenderers, OptionCondition::Always, {"4"}},
     {"--threads", kAllRenderers, OptionCondition::Always, {"1"}},
     {"--debug-pixel", kAllRenderers, OptionCondition::Always, {"1", "1"}},
+    {"--max-memory", kAllRenderers, OptionCondition::Always, {"8G"}},
     {"--texture-filter", kAllRenderers, OptionCondition::Always, {"nearest"}},
     {"--origin", kAllRenderers, OptionCondition::Always, {"world"}},
     {"--cull", kAllRenderers, OptionCondition::Always, {"back"}},
