@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "app/memory_estimate.h"
 #include "app/serve_api.h"
 #include "app/stability_measure.h"
 #include "common/camera.h"
@@ -133,6 +134,9 @@ std::shared_ptr<PreparedFrame> SceneCache::frame(const std::string& path,
   frame->raster = settings.raster;
   frame->ray = settings.ray;
   frame->raster.keepSamples = frame->ray.keepSamples = false;
+  frame->memory = estimateRenderMemory(*frame->scene, settings);
+  checkMemory(frame->memory, settings.memory, frame->scene->path, "",
+              describeRenderWork(settings, toString(settings.renderer)));
   frame->renderer =
       std::make_unique<FrameRenderer>(*frame->scene, frame->settings, frame->raster, frame->ray);
   frames_.insert(key, frame);
@@ -157,6 +161,7 @@ RenderRun renderPrepared(PreparedFrame& frame) {
   run.analysis = frame.renderer->analysis();
   run.output = frame.renderer->frame();
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.memoryEstimate = frame.memory;
   if (!frame.reused && frame.renderer->bvhBuildSeconds() >= 0.0) {
     run.output.timings.insert(run.output.timings.begin(),
                               {"raytrace.bvh_build", frame.renderer->bvhBuildSeconds()});

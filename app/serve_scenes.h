@@ -26,6 +26,7 @@
 
 #include "app/crossval.h"
 #include "app/render_setup.h"
+#include "common/memory_budget.h"
 #include "common/scene.h"
 
 namespace rastray::serve {
@@ -85,7 +86,8 @@ struct PreparedFrame {
   RasterOptions raster;
   RayOptions ray;
   std::unique_ptr<FrameRenderer> renderer;
-  bool reused = false;  // true once a later request found it in the cache
+  MemoryEstimate memory;  // checked against settings.memory (--max-memory) before preparing
+  bool reused = false;    // true once a later request found it in the cache
 };
 
 class SceneCache {
@@ -96,7 +98,9 @@ class SceneCache {
   // loadSceneForRender gives it.
   std::shared_ptr<const Scene> prepared(const std::string& path, const RenderSettings& settings);
   // A FrameRenderer for these settings (`args`: their command-line form,
-  // the cache key); settings.finish() done.
+  // the cache key); settings.finish() done. Refused (InputError) when the
+  // render's estimated peak memory exceeds --max-memory, as renderScene
+  // refuses it.
   std::shared_ptr<PreparedFrame> frame(const std::string& path, const std::vector<std::string>& args,
                                        const RenderSettings& settings);
   // crossvalidate() of the prepared scene under these (all-renderer)
@@ -109,7 +113,7 @@ class SceneCache {
   LruCache<const Scene> loaded_{8};
   LruCache<const Scene> prepared_{3};
   LruCache<PreparedFrame> frames_{4};
-  LruCache<const CrossvalResult> crossvals_{2};
+  LruCache<const CrossvalResult> crossvals_{1};  // deep frames of three renders: the largest entries
 };
 
 // One render of a prepared frame, as renderScene reports it: the

@@ -104,6 +104,7 @@ let previewAgain = false;
 let dragging = false;
 let firstFrameDone = null; // resolves when the first final frame is on screen (selftest)
 const firstFrame = new Promise((resolve) => { firstFrameDone = resolve; });
+const frameWaiters = []; // resolved after the next final frame (selftest)
 
 async function fetchFrame(query, signal) {
   query.set('client', client);
@@ -135,7 +136,10 @@ async function requestFrame(preview) {
     else await showFinal(ctl.signal);
     const ms = Math.round(performance.now() - started);
     setStatus((preview ? 'preview, ' : '') + ms + ' ms');
-    if (!preview) firstFrameDone();
+    if (!preview) {
+      firstFrameDone();
+      for (const resolve of frameWaiters.splice(0)) resolve();
+    }
   } catch (e) {
     if (e.name !== 'AbortError') setStatus(e.message, true);
     if (e.name !== 'AbortError' && !preview) failSelftest('frame: ' + e.message);
@@ -152,6 +156,7 @@ async function showPreview(signal) {
   const j = await fetchFrame(renderQuery(false, state.renderer, {spp: '1'}), signal);
   await loadImage($('image-a'), j.image);
   $('image-b').hidden = true;
+  for (const id of ['swipe-line', 'label-a', 'label-b']) $(id).hidden = true;
 }
 
 async function showFinal(signal) {
@@ -168,7 +173,7 @@ async function showFinal(signal) {
   applySwipe();
   lastFrame = {width: a.size[0], height: a.size[1]};
   sizeOverlay();
-  $('command').textContent = a.command;
+  $('command').textContent = a.command + (b ? '\n' + b.command : '');
   showLegend(a);
   showWork(a, b);
   rememberInUrl();
@@ -177,8 +182,12 @@ async function showFinal(signal) {
 
 function applySwipe() {
   // The second renderer shows right of the slider.
+  const swipe = state.view === 'swipe';
   $('image-b').style.clipPath = 'inset(0 0 0 ' + $('swipe').value + '%)';
-  $('swipe').hidden = state.view !== 'swipe';
+  $('swipe-line').style.left = $('swipe').value + '%';
+  for (const id of ['swipe', 'swipe-line', 'label-a', 'label-b']) $(id).hidden = !swipe;
+  $('label-a').textContent = state.renderer;
+  $('label-b').textContent = state.swipeWith;
 }
 
 function sizeOverlay() {
@@ -575,7 +584,7 @@ async function loadScene(keepCamera) {
   state.sceneInfo = await getJson('/api/scene?' + q.toString());
   if (!keepCamera) state.camera = null;
   const pick = $('camera-pick');
-  pick.replaceChildren(new Option('scene camera: ' + state.sceneInfo.camera.origin, 'scene'),
+  pick.replaceChildren(new Option(state.sceneInfo.camera.origin, 'scene'),
                        new Option('moved (drag, pan, zoom)', 'moved'));
   pick.value = state.camera ? 'moved' : 'scene';
 }
@@ -604,10 +613,12 @@ function bindEvents() {
   window.addEventListener('mouseup', onMouseUp);
 }
 
-// ---- self test (?selftest=click:X,Y) --------------------------------------
-// For the headless-browser test and the README screenshot: after the first
-// image, click pixel (X, Y) through the same mouse handlers a user's click
-// reaches, wait for the explain panel, and report in #selftest-result.
+// ---- self test (?selftest=STEP;STEP...) ----------------------------------
+// For the headless-browser test and the README screenshot. After the first
+// image, each step acts through the same mouse handlers a user reaches:
+// drag:DX,DY orbits (left button, from the image centre, DX, DY CSS pixels)
+// and waits for the refined image; click:X,Y clicks image pixel (X, Y) and
+// waits for the explain panel. The outcome goes to #selftest-result.
 let selftestOn = false;
 function failSelftest(message) {
   if (!selftestOn) return;
@@ -615,7 +626,6 @@ function failSelftest(message) {
   if (r.dataset.status) return;
   r.dataset.status = 'fail';
   r.textContent = 'selftest failed: ' + message;
-  r.hidden = false;
 }
 
 // A whole-number client coordinate (mouse events carry integers) inside
@@ -631,27 +641,57 @@ function clientCoordinate(axis, p) {
   return target;
 }
 
+function mouse(target, type, x, y) {
+  target.dispatchEvent(new MouseEvent(type, {clientX: x, clientY: y, button: 0, bubbles: true}));
+}
+
+async function selftestDrag(dx, dy) {
+  const refined = new Promise((resolve) => { frameWaiters.push(resolve); });
+  const rect = $('image-a').getBoundingClientRect();
+  const x = Math.round(rect.left + rect.width / 2), y = Math.round(rect.top + rect.height / 2);
+  mouse($('stage'), 'mousedown', x, y);
+  for (let i = 1; i <= 4; ++i) mouse(window, 'mousemove', x + Math.round(dx * i / 4), y + Math.round(dy * i / 4));
+  mouse(window, 'mouseup', x + dx, y + dy);
+  await refined;
+  const eye = / --eye (\S+ \S+ \S+)/.exec($('command').textContent);
+  if (!eye) throw new Error('the command line has no --eye after orbiting');
+  return 'drag to eye ' + eye[1];
+}
+
+async function selftestClick(px, py) {
+  const explained = new Promise((resolve) => { explainShown = resolve; });
+  const x = clientCoordinate('x', px), y = clientCoordinate('y', py);
+  mouse($('stage'), 'mousedown', x, y);
+  mouse($('stage'), 'mouseup', x, y);
+  const j = await explained;
+  if (!$('explain-body').querySelector('.explain-done') || j.explain.samples.length === 0) {
+    throw new Error('the explain panel stayed empty');
+  }
+  return 'pixel (' + j.explain.pixel.join(', ') + '), ' + j.explain.samples.length + ' samples, ' +
+         $('overlay').querySelectorAll('.ray').length + ' rays drawn';
+}
+
 async function runSelftest(spec) {
   selftestOn = true;
-  const m = /^click:(\d+),(\d+)$/.exec(spec);
-  if (!m) { failSelftest('unknown selftest ' + spec); return; }
   const timer = setTimeout(() => failSelftest('timed out'), 60000);
-  await firstFrame;
-  const explained = new Promise((resolve) => { explainShown = resolve; });
-  const at = {clientX: clientCoordinate('x', Number(m[1])), clientY: clientCoordinate('y', Number(m[2])),
-              button: 0, bubbles: true};
-  $('stage').dispatchEvent(new MouseEvent('mousedown', at));
-  $('stage').dispatchEvent(new MouseEvent('mouseup', at));
-  const j = await explained;
-  clearTimeout(timer);
-  const r = $('selftest-result');
-  if (r.dataset.status) return;
-  const panel = $('explain-body');
-  const ok = panel.querySelector('.explain-done') && j.explain.samples.length > 0;
-  r.dataset.status = ok ? 'ok' : 'fail';
-  r.textContent = 'selftest ' + (ok ? 'ok' : 'failed') + ': pixel (' + j.explain.pixel.join(', ') + '), ' +
-                  j.explain.samples.length + ' samples, ' + $('overlay').querySelectorAll('.ray').length +
-                  ' rays drawn';
+  try {
+    await firstFrame;
+    const done = [];
+    for (const step of spec.split(';')) {
+      const m = /^(click|drag):(-?\d+),(-?\d+)$/.exec(step);
+      if (!m) throw new Error('unknown step ' + step);
+      done.push(await (m[1] === 'click' ? selftestClick : selftestDrag)(Number(m[2]), Number(m[3])));
+    }
+    const r = $('selftest-result');
+    if (!r.dataset.status) {
+      r.dataset.status = 'ok';
+      r.textContent = 'selftest ok: ' + done.join('; ');
+    }
+  } catch (e) {
+    failSelftest(e.message);
+  } finally {
+    clearTimeout(timer);
+  }
 }
 
 // ---- start --------------------------------------------------------------------

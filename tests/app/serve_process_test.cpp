@@ -117,10 +117,11 @@ class ServeProcess {
   bool exited_ = false;
 };
 
-// The page in a real browser: it loads, shows the first image, a click on
-// a pixel (through the page's own mouse handlers: the ?selftest hook)
-// fills the explain panel and draws the ray tree; the page reports it in
-// #selftest-result, which --dump-dom prints.
+// The page in a real browser: it loads, shows the first image, a drag
+// orbits the camera (the refined image's command line has --eye), a click
+// on a pixel fills the explain panel and draws the ray tree. The mouse
+// events go through the page's own handlers (the ?selftest hook), which
+// reports in #selftest-result; --dump-dom prints it.
 TEST(ServeBrowser, PageShowsTheImageAndExplainsAClickedPixel) {
   const char* chromium = "/usr/bin/chromium";
   ASSERT_TRUE(fs::exists(chromium))
@@ -129,7 +130,8 @@ TEST(ServeBrowser, PageShowsTheImageAndExplainsAClickedPixel) {
   const fs::path dir = freshDir("serve-browser");
   ServeProcess server({scenePath("cornell-box")}, dir);
   ASSERT_GT(server.port(), 0) << server.err();
-  const std::string page = server.url() + "?renderer=raytrace&size=160,120&spp=4&selftest=click:70,40";
+  const std::string page =
+      server.url() + "?renderer=raytrace&size=160,120&spp=4&selftest=drag:30,-10;click:70,40";
   const fs::path dom = dir / "dom.html";
   const std::string cmd = std::string("timeout 300 ") + chromium +
                           " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
@@ -145,6 +147,7 @@ TEST(ServeBrowser, PageShowsTheImageAndExplainsAClickedPixel) {
       << "no self-test result in the page:\n"
       << html.substr(0, 4000);
   EXPECT_NE(result[0].str().find("data-status=\"ok\""), std::string::npos) << result[0];
+  EXPECT_NE(result[1].str().find("drag to eye "), std::string::npos) << result[1];
   EXPECT_NE(result[1].str().find("pixel (70, 40), 4 samples"), std::string::npos) << result[1];
   // The first image arrived as a PNG, the explain panel is filled, and the
   // ray tree is drawn over the image (a shadow ray per sample at least).
@@ -152,9 +155,8 @@ TEST(ServeBrowser, PageShowsTheImageAndExplainsAClickedPixel) {
   EXPECT_NE(html.find("class=\"explain-done\""), std::string::npos);
   EXPECT_NE(html.find("hits per sample"), std::string::npos);
   EXPECT_NE(html.find("class=\"ray ray-shadow"), std::string::npos);
-  EXPECT_NE(
-      html.find("rastray render " + scenePath("cornell-box") + " --renderer raytrace --size 160 120 --spp 4"),
-      std::string::npos);
+  EXPECT_NE(html.find("rastray render " + scenePath("cornell-box") + " --renderer raytrace --eye "),
+            std::string::npos);
   EXPECT_EQ(server.stop(SIGTERM), 128 + SIGTERM) << server.err();
   fs::remove_all(dir);
 }
