@@ -20,6 +20,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "common/error.h"
+#include "common/exr_header.h"
 #include "common/scene.h"
 
 namespace rastray {
@@ -124,12 +125,34 @@ void checkFlat(const FlatImage& image) {
                     std::to_string(image.color.size()) + " colours");
 }
 
-std::unique_ptr<OIIO::ImageInput> openExr(const std::string& path) {
-  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path);
-  if (!in) throw InputError(path, "", "cannot read: " + OIIO::geterror());
-  if (std::strcmp(in->format_name(), "openexr") != 0) {
-    throw InputError(path, "", std::string("not an OpenEXR file (") + in->format_name() + ")");
-  }
+// Only OpenImageIO's OpenEXR reader sees the file: ImageInput::open would
+// offer a file that is not EXR to every format plugin it has (DICOM, RAW,
+// movies, ...), each a large decoder run for nothing but a refusal.
+// Opening a deep file, OpenEXR allocates a sample count (4 bytes) per
+// pixel of the data window, and reading it OpenImageIO a pointer per pixel
+// and channel: refused before either happens when the file cannot hold
+// that many pixels, or when it exceeds `maxBytes`. A deep file stores each
+// pixel's count (4 bytes) compressed with zlib, RLE or not at all; zlib's
+// best ratio is 1032:1 (a deflate block of repeated bytes), so a file holds
+// at most 258 deep pixels per byte. (A 1.5 KB file declaring 50 million
+// deep pixels had OpenImageIO allocate 3.6 GB; tests/data/fuzz-regressions.)
+constexpr uint64_t kMaxDeepPixelsPerByte = 1032 / 4;
+
+std::unique_ptr<OIIO::ImageInput> openExr(const std::string& path, uint64_t maxBytes) {
+  const ExrHeaderFacts facts = checkExrHeaders(path);
+  if (facts.deep && facts.dataPixels / kMaxDeepPixelsPerByte > facts.fileSize)
+    throw InputError(path, "header",
+                     "deep data window of " + std::to_string(facts.dataPixels) +
+                         " pixels cannot be stored in " + std::to_string(facts.fileSize) +
+                         " bytes (at most " + std::to_string(kMaxDeepPixelsPerByte) + " pixels a byte)");
+  if (facts.dataPixels > maxBytes / 4)
+    throw InputError(path, "",
+                     "reading it needs more than " + std::to_string(facts.dataPixels) + " x 4 bytes (its " +
+                         "data window is too large), above the limit of " + std::to_string(maxBytes));
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::create("openexr");
+  if (!in) throw InputError(path, "", "cannot read: OpenImageIO has no OpenEXR reader: " + OIIO::geterror());
+  OIIO::ImageSpec opened;
+  if (!in->open(path, opened)) throw InputError(path, "", "cannot read: " + in->geterror());
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.depth != 1 || spec.width <= 0 || spec.height <= 0) {
     throw InputError(path, "", "unsupported data window (volume or empty)");
@@ -425,18 +448,61 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
   writeAtomically(path, "openexr", spec, [&](OIIO::ImageOutput& out) { return out.write_deep_image(deep); });
 }
 
-bool isDeepExr(const std::string& path) { return openExr(path)->spec().deep; }
+bool isDeepExr(const std::string& path, uint64_t maxBytes) { return openExr(path, maxBytes)->spec().deep; }
 
 namespace {
 
-FlatImage readExrUnchecked(const std::string& path) {
-  std::unique_ptr<OIIO::ImageInput> in = openExr(path);
+uint64_t mulSat(uint64_t a, uint64_t b) {
+  uint64_t r;
+  return __builtin_mul_overflow(a, b, &r) ? UINT64_MAX : r;
+}
+
+uint64_t addSat(uint64_t a, uint64_t b) {
+  uint64_t r;
+  return __builtin_add_overflow(a, b, &r) ? UINT64_MAX : r;
+}
+
+// Upper bounds of what the readers below allocate for `spec`, per pixel of
+// the data window and of the display window (bytes, from the structures:
+// FlatImage holds a vec4, a float and two uint32 per pixel).
+uint64_t flatReadBytes(const OIIO::ImageSpec& spec) {
+  const Windows w = windowsOf(spec);
+  const uint64_t data = mulSat(uint64_t(w.dataWidth), uint64_t(w.dataHeight));
+  const uint64_t display = mulSat(uint64_t(w.width), uint64_t(w.height));
+  // The native buffer, the data-window FlatImage, a double per pixel for a
+  // half or float ID channel, and the display-window FlatImage.
+  const uint64_t perDataPixel =
+      addSat(uint64_t(spec.pixel_bytes(true)), sizeof(FlatImage::color[0]) + 12 + 8);
+  return addSat(mulSat(data, perDataPixel), mulSat(display, sizeof(FlatImage::color[0]) + 12));
+}
+
+uint64_t deepReadBytes(const OIIO::ImageSpec& spec) {
+  const Windows w = windowsOf(spec);
+  const uint64_t data = mulSat(uint64_t(w.dataWidth), uint64_t(w.dataHeight));
+  const uint64_t display = mulSat(uint64_t(w.width), uint64_t(w.height));
+  // OpenEXR's deep frame buffer holds a pointer per pixel and channel;
+  // OIIO's DeepData a count, a capacity and a cumulative capacity per
+  // pixel; the DeepImage an offset per display pixel. Samples come on top.
+  const uint64_t perDataPixel = addSat(mulSat(uint64_t(std::max(spec.nchannels, 0)), 8), 12);
+  return addSat(mulSat(data, perDataPixel), mulSat(addSat(display, 1), 8));
+}
+
+void checkReadBytes(const std::string& path, uint64_t needed, uint64_t maxBytes) {
+  if (needed <= maxBytes) return;
+  throw InputError(path, "",
+                   "reading it needs more than " + std::to_string(needed) + " bytes (its windows are " +
+                       "too large), above the limit of " + std::to_string(maxBytes));
+}
+
+FlatImage readExrUnchecked(const std::string& path, uint64_t maxBytes) {
+  std::unique_ptr<OIIO::ImageInput> in = openExr(path, maxBytes);
   const OIIO::ImageSpec spec = in->spec();
   // Flattening a deep file needs the sample pattern (average the per-sample
   // composites, Z and IDs from the centre sample), which only the caller
   // knows; so we refuse and let the caller use readDeepExr.
   if (spec.deep) throw InputError(path, "", "deep EXR where a flat one is expected");
   const ColorChannels cc = colorChannelsOf(path, spec);
+  checkReadBytes(path, flatReadBytes(spec), maxBytes);
   const int cZ = spec.channelindex(kZ);
 
   // One decode in the file's own formats; every channel is then converted
@@ -482,11 +548,12 @@ FlatImage readExrUnchecked(const std::string& path) {
   return image;
 }
 
-DeepImage readDeepExrUnchecked(const std::string& path) {
-  std::unique_ptr<OIIO::ImageInput> in = openExr(path);
+DeepImage readDeepExrUnchecked(const std::string& path, uint64_t maxBytes) {
+  std::unique_ptr<OIIO::ImageInput> in = openExr(path, maxBytes);
   const OIIO::ImageSpec spec = in->spec();
   if (!spec.deep) throw InputError(path, "", "flat EXR where a deep one is expected");
   const ColorChannels cc = colorChannelsOf(path, spec);
+  checkReadBytes(path, deepReadBytes(spec), maxBytes);
   const int cZ = spec.channelindex(kZ);
   const int cInstance = spec.channelindex(kInstance);
   const int cTriangle = spec.channelindex(kTriangle);
@@ -549,9 +616,10 @@ DeepImage readDeepExrUnchecked(const std::string& path) {
 // A damaged header can claim any size; what cannot be allocated is bad
 // input, not a crash.
 template <typename Read>
-auto readWithinMemory(const std::string& path, Read read) -> decltype(read(path)) {
+auto readWithinMemory(const std::string& path, uint64_t maxBytes, Read read)
+    -> decltype(read(path, maxBytes)) {
   try {
-    return read(path);
+    return read(path, maxBytes);
   } catch (const std::bad_alloc&) {
     throw InputError(path, "", "image too large to load");
   } catch (const std::length_error&) {
@@ -561,8 +629,12 @@ auto readWithinMemory(const std::string& path, Read read) -> decltype(read(path)
 
 }  // namespace
 
-FlatImage readExr(const std::string& path) { return readWithinMemory(path, readExrUnchecked); }
+FlatImage readExr(const std::string& path, uint64_t maxBytes) {
+  return readWithinMemory(path, maxBytes, readExrUnchecked);
+}
 
-DeepImage readDeepExr(const std::string& path) { return readWithinMemory(path, readDeepExrUnchecked); }
+DeepImage readDeepExr(const std::string& path, uint64_t maxBytes) {
+  return readWithinMemory(path, maxBytes, readDeepExrUnchecked);
+}
 
 }  // namespace rastray

@@ -104,10 +104,17 @@ void writeDeepExr(const std::string& path, const DeepImage& image);
 // - readDeepExr returns each pixel's samples in the DeepImage order, sorting
 //   if the file had another (NaN depths last); a missing id.sample reads as
 //   0, i.e. all layers of a pixel belong to one sample.
-FlatImage readExr(const std::string& path);
-DeepImage readDeepExr(const std::string& path);
-// Throws InputError like the readers when the file cannot be opened as EXR.
-bool isDeepExr(const std::string& path);
+// - Before decoding, the bytes the read will allocate are estimated from
+//   the header (data and display windows, channels; for a deep file not
+//   its samples, whose counts OpenImageIO reads and allocates in one call)
+//   and the file is refused above `maxBytes`: a header can claim any size.
+//   Allocation failures past the estimate are InputErrors too.
+constexpr uint64_t kNoReadLimit = UINT64_MAX;
+FlatImage readExr(const std::string& path, uint64_t maxBytes = kNoReadLimit);
+DeepImage readDeepExr(const std::string& path, uint64_t maxBytes = kNoReadLimit);
+// Throws InputError like the readers when the file cannot be opened as EXR
+// (or its data window alone needs more than maxBytes to open).
+bool isDeepExr(const std::string& path, uint64_t maxBytes = kNoReadLimit);
 
 // Writes a text file (HTML, CSV, JSON) the same atomic way as images.
 // Throws InputError (file: path) when it cannot.

@@ -111,7 +111,7 @@ CompareResult compareFiles(const CompareInputs& in) {
   r.pathA = in.pathA;
   r.pathB = in.pathB;
   r.scenePath = in.scenePath;
-  const bool deepA = isDeepExr(in.pathA), deepB = isDeepExr(in.pathB);
+  const bool deepA = isDeepExr(in.pathA, in.maxImageBytes), deepB = isDeepExr(in.pathB, in.maxImageBytes);
   if (deepA != deepB)
     throw InputError(in.pathB, "",
                      std::string(deepB ? "deep" : "flat") + " EXR, but " + in.pathA + " is " +
@@ -122,13 +122,13 @@ CompareResult compareFiles(const CompareInputs& in) {
   DeepImage deepImageA, deepImageB;
   int width, height;
   if (deepA) {
-    deepImageA = readDeepExr(in.pathA);
-    deepImageB = readDeepExr(in.pathB);
+    deepImageA = readDeepExr(in.pathA, in.maxImageBytes);
+    deepImageB = readDeepExr(in.pathB, in.maxImageBytes);
     width = deepImageA.width;
     height = deepImageA.height;
   } else {
-    flatA = readExr(in.pathA);
-    flatB = readExr(in.pathB);
+    flatA = readExr(in.pathA, in.maxImageBytes);
+    flatB = readExr(in.pathB, in.maxImageBytes);
     width = flatA.width;
     height = flatA.height;
   }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/camera.h"
+#include "common/image.h"
 #include "compare/color_metrics.h"
 #include "compare/visibility.h"
 
@@ -26,6 +27,8 @@ struct CompareInputs {
   int spp = 0;  // 0: not given
   StoredDepthFormat depthFormat = StoredDepthFormat::FloatReversed;
   double edgeDistance = kDefaultEdgeDistance;
+  // Each file is refused when reading it would allocate more (readExr).
+  uint64_t maxImageBytes = kNoReadLimit;
 };
 
 struct CompareResult {

@@ -14,6 +14,7 @@ packages=(
   libcpp-httplib-dev  # the HTTP server of `rastray serve`, the browser explorer
   libosmesa6-dev embree-tools  # performance peers of `rastray bench --peers`: Mesa llvmpipe, Embree's viewer
   assimp-testmodels  # real-world glTF models: the CAD-like 2CylinderEngine.glb that `rastray bench` measures
+  clang libfuzzer-14-dev libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer targets (fuzz/, -DRASTRAY_FUZZ=ON) need clang
 )
 
 missing=()

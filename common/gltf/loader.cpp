@@ -168,8 +168,12 @@ Scene loadScene(const std::string& path, const MemoryBudget& budget) {
 
 Scene loadScene(const std::string& path) { return loadScene(path, MemoryBudget::machineDefault()); }
 
+Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes, const MemoryBudget& budget) {
+  return loadDocument(parseGltfDocument(path, std::move(bytes)), budget);
+}
+
 Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes) {
-  return loadDocument(parseGltfDocument(path, std::move(bytes)), MemoryBudget::machineDefault());
+  return loadSceneFromMemory(path, std::move(bytes), MemoryBudget::machineDefault());
 }
 
 }  // namespace rastray

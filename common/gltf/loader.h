@@ -28,6 +28,8 @@ Scene loadScene(const std::string& path);
 // The same for a file's bytes already in memory (the fuzz target's entry;
 // fuzz/gltf_loader_fuzzer.cpp): `path` names the file in messages, and
 // external buffers and images are resolved beside it, as for loadScene.
+Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes, const MemoryBudget& budget);
+// With the machine's default budget.
 Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes);
 
 }  // namespace rastray
