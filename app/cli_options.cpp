@@ -7,6 +7,10 @@ glm::dvec3 vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 }  // namespace
 
 void CameraOptions::addTo(CLI::App& app) {
+  app.add_option("--camera", camera,
+                 "The file's camera N (camera nodes in walk order, as `info` lists them; default the "
+                 "first); --eye etc. apply on top")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--eye", eye, "Camera position X Y Z (world space)")->expected(3);
   app.add_option("--target", target, "Point the camera looks at, X Y Z")->expected(3);
   app.add_option("--up", up, "Camera up vector X Y Z")->expected(3);
@@ -22,6 +26,7 @@ void CameraOptions::addTo(CLI::App& app) {
 
 CameraOverrides CameraOptions::overrides() const {
   CameraOverrides o;
+  if (camera >= 0) o.camera = size_t(camera);
   if (!eye.empty()) o.eye = vec3(eye);
   if (!target.empty()) o.target = vec3(target);
   if (!up.empty()) o.up = vec3(up);

@@ -15,6 +15,7 @@ constexpr int kDefaultWidth = 640;
 constexpr int kDefaultHeight = 480;
 
 struct CameraOptions {
+  int camera = -1;                      // --camera N: the file's camera node N (walk order); -1: the first
   std::vector<double> eye, target, up;  // 3 values each when given
   double yfov = 0, znear = 0, zfar = 0;
   CLI::Option* yfovOption = nullptr;

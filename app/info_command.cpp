@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -10,6 +11,7 @@
 #include "app/commands.h"
 #include "common/analysis.h"
 #include "common/camera.h"
+#include "common/error.h"
 #include "common/gltf/loader.h"
 #include "common/math_constants.h"
 #include "common/scene.h"
@@ -45,6 +47,25 @@ MaterialCounts countMaterials(const Scene& scene) {
 }
 
 nlohmann::json vec(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+
+// Camera node i of the file (--camera i) bound to the image size without
+// other overrides; nullopt with the reason when makeCamera refuses it.
+std::optional<Camera> fileCamera(const Scene& scene, size_t i, int width, int height, std::string& error) {
+  CameraOverrides pick;
+  pick.camera = i;
+  try {
+    return makeCamera(scene, pick, width, height);
+  } catch (const InputError& e) {
+    error = e.message();
+    return std::nullopt;
+  }
+}
+
+// "point 'Lamp' node 4": a light as `info` lists it (its index is --lights').
+std::string describeLight(const Light& l) {
+  return std::string(toString(l.type)) + (l.name.empty() ? "" : " '" + l.name + "'") + " node " +
+         std::to_string(l.node);
+}
 
 // JSON numbers cannot be infinite: +inf is written as the string "inf".
 nlohmann::json number(double d) {
@@ -97,8 +118,34 @@ int runInfo(const InfoOptions& opt) {
       ignored.push_back(
           {{"feature", f.feature}, {"unit", f.unit}, {"count", f.count}, {"text", f.describe()}});
     j["ignored"] = ignored;
+    nlohmann::json lightList = nlohmann::json::array();
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+      const Light& l = scene.lights[i];
+      nlohmann::json e = {{"index", i}, {"name", l.name}, {"type", toString(l.type)}, {"node", l.node}};
+      if (l.type != LightType::Directional) e["position"] = vec(l.position);
+      if (l.type != LightType::Point) e["direction"] = vec(l.direction);
+      lightList.push_back(e);
+    }
+    j["lightList"] = lightList;
     j["cameras"] = scene.stats.cameras;
     j["cameraNodes"] = scene.stats.cameraNodes;
+    // Every camera node in walk order, as --camera N picks it (no other overrides).
+    nlohmann::json cameraList = nlohmann::json::array();
+    for (size_t i = 0; i < scene.cameras.size(); ++i) {
+      std::string error;
+      const std::optional<Camera> c = fileCamera(scene, i, opt.camera.width(), opt.camera.height(), error);
+      if (c)
+        cameraList.push_back({{"index", i},
+                              {"origin", c->origin},
+                              {"projection", toString(c->projection)},
+                              {"yfovDegrees", c->yfov * 180.0 / kPi},
+                              {"eye", vec(c->eye())},
+                              {"forward", vec(c->forward())},
+                              {"description", c->describe()}});
+      else
+        cameraList.push_back({{"index", i}, {"origin", scene.cameras[i].origin}, {"error", error}});
+    }
+    j["cameraList"] = cameraList;
     if (scene.bounds.empty())
       j["bounds"] = nullptr;
     else
@@ -158,7 +205,15 @@ int runInfo(const InfoOptions& opt) {
   std::printf("textures   %zu (%zu images)\n", scene.textures.size(), scene.images.size());
   std::printf("lights     %zu: %d point, %d spot, %d directional\n", scene.lights.size(), lightsByType[0],
               lightsByType[1], lightsByType[2]);
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    std::printf("  light %-4zu %s\n", i, describeLight(scene.lights[i]).c_str());
   std::printf("cameras    %u defined, %u camera nodes\n", scene.stats.cameras, scene.stats.cameraNodes);
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    std::string error;
+    const std::optional<Camera> c = fileCamera(scene, i, opt.camera.width(), opt.camera.height(), error);
+    std::printf("  camera %-3zu %s\n", i,
+                c ? c->describe().c_str() : (scene.cameras[i].origin + ": " + error).c_str());
+  }
   if (scene.bounds.empty())
     std::printf("bounds     empty (nothing to render: background only)\n");
   else

@@ -29,6 +29,28 @@ Enum pick(const std::string& option, const std::string& value,
   badOption(option, "'" + value + "' is not one of " + names);
 }
 
+// --lights: nullopt for "all", else the indices to keep (sorted, unique;
+// empty for "none"). Checked against the scene by selectLights.
+std::optional<std::vector<size_t>> parseLightList(const std::string& value) {
+  if (value == "all") return std::nullopt;
+  std::vector<size_t> kept;
+  if (value == "none") return kept;
+  size_t start = 0;
+  while (start <= value.size()) {
+    const size_t end = std::min(value.find(',', start), value.size());
+    const std::string item = value.substr(start, end - start);
+    // At most 9 digits: no scene holds a billion lights, and stoul cannot overflow.
+    if (item.empty() || item.size() > 9 ||
+        !std::all_of(item.begin(), item.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      badOption("--lights", "'" + value + "' is not all, none or comma-separated light indices (e.g. 0,2)");
+    kept.push_back(std::stoul(item));
+    start = end + 1;
+  }
+  std::sort(kept.begin(), kept.end());
+  kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
+  return kept;
+}
+
 }  // namespace
 
 const char* toString(RendererKind kind) {
@@ -87,6 +109,7 @@ std::string describeRenderers(RendererSet set) {
 
 const std::vector<RenderOptionSpec> kRenderOptions = {
     // Camera (SPEC §2): registered by CameraOptions, shared with info and compare.
+    {"--camera", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
     {"--eye", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
     {"--target", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
     {"--up", kAllRenderers, OptionCondition::Always, nullptr, nullptr},
@@ -112,6 +135,9 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
     {"--origin", kAllRenderers, OptionCondition::Always,
      "camera (rebase the scene on the eye before rounding to float) or world (no rebasing)",
      RASTRAY_BIND(cmd.add_option(name, s.origin, help)->capture_default_str())},
+    {"--lights", kAllRenderers, OptionCondition::Always,
+     "Lights to keep: all, none, or indices as `info` lists them, e.g. 0,2 (none left: the eye light)",
+     RASTRAY_BIND(cmd.add_option(name, s.lights, help)->capture_default_str())},
     {"--cull", kAllRenderers, OptionCondition::Always, "Cull single-sided triangles: back, front or none",
      RASTRAY_BIND(cmd.add_option(name, s.cull, help)->capture_default_str())},
     {"--shadows", kAllRenderers, OptionCondition::Always,
@@ -249,6 +275,7 @@ void RenderSettings::finish() {
   ray.offset = pick<RayOffsetMethod>(
       "--ray-offset", rayOffset,
       {{"error-bound", RayOffsetMethod::ErrorBound}, {"float-ulps", RayOffsetMethod::FloatUlps}});
+  keptLights = parseLightList(lights);
   if (!debugPixelXY.empty()) debugPixel = glm::ivec2(debugPixelXY[0], debugPixelXY[1]);
   memory = maxMemory.empty() ? MemoryBudget::machineDefault() : MemoryBudget::parse(maxMemory);
 
@@ -338,9 +365,26 @@ void RenderSettings::finish() {
   }
 }
 
+void selectLights(Scene& scene, const RenderSettings& settings) {
+  if (!settings.keptLights) return;
+  const std::vector<size_t>& kept = *settings.keptLights;
+  const size_t count = scene.lights.size();
+  if (!kept.empty() && kept.back() >= count)
+    badOption("--lights", "light " + std::to_string(kept.back()) + " does not exist: the scene has " +
+                              std::to_string(count) + " light" + (count == 1 ? "" : "s"));
+  std::vector<Light> lights;
+  for (size_t i : kept) lights.push_back(scene.lights[i]);
+  scene.lights = std::move(lights);
+}
+
+void prepareSceneForRender(Scene& scene, const RenderSettings& settings) {
+  selectLights(scene, settings);
+  applyRenderOrigin(scene, settings.renderOrigin, settings.camera.overrides());
+}
+
 Scene loadSceneForRender(const std::string& path, const RenderSettings& settings) {
   Scene scene = loadScene(path, settings.memory);
-  applyRenderOrigin(scene, settings.renderOrigin, settings.camera.overrides());
+  prepareSceneForRender(scene, settings);
   return scene;
 }
 

@@ -78,6 +78,8 @@ struct RenderSettings {
   std::string cull = "none", depthFormat = "float-reversed", depthFunc = "less", shadingRate = "sample";
   std::string textureFilter = "sampler";
   std::string origin = "camera", rayOffset = "error-bound";
+  std::string lights = "all";                     // --lights: all, none or indices "0,2"
+  std::optional<std::vector<size_t>> keptLights;  // set by finish(): nullopt keeps all
   RenderOrigin renderOrigin = RenderOrigin::Camera;
   std::vector<float> polygonOffset, shadowBias;
   std::vector<int> debugPixelXY;
@@ -150,8 +152,18 @@ struct RenderRun {
   MemoryEstimate memoryEstimate;  // checked against RenderSettings::memory before rendering
 };
 
-// Loads a scene and rebases it on the render origin --origin names
-// (applyRenderOrigin); settings.finish() must have been called.
+// Keeps only the lights --lights names (Scene::lights indices, as `info`
+// lists them), before the scene is analysed: with none left, SPEC §8's
+// decisions follow (the eye light, no shadow work). Throws InputError
+// naming --lights and the light count for an index out of range.
+void selectLights(Scene& scene, const RenderSettings& settings);
+
+// What loadSceneForRender does to a loaded scene: selectLights, then the
+// rebasing on the render origin --origin names (applyRenderOrigin).
+void prepareSceneForRender(Scene& scene, const RenderSettings& settings);
+
+// Loads a scene and prepares it (prepareSceneForRender); settings.finish()
+// must have been called.
 Scene loadSceneForRender(const std::string& path, const RenderSettings& settings);
 
 // Runs the chosen renderer; settings.finish() must have been called.

@@ -67,7 +67,8 @@ std::vector<std::string> optionTokens(const RenderOptionSpec& spec, const std::s
     if (value != "on") badRequest(name + ": '" + value + "': a flag takes on or off");
     return {spec.name};
   }
-  std::vector<std::string> tokens = splitCommas(value);
+  // One value is taken whole: it may hold commas of its own (--lights 0,2).
+  std::vector<std::string> tokens = arity == 1 ? std::vector<std::string>{value} : splitCommas(value);
   if (int(tokens.size()) != arity ||
       std::any_of(tokens.begin(), tokens.end(), [](const std::string& t) { return t.empty(); }))
     badRequest(name + ": '" + value + "': needs " + std::to_string(arity) + " value" +

@@ -99,7 +99,7 @@ std::shared_ptr<const Scene> SceneCache::loaded(const std::string& path) {
 
 std::shared_ptr<const Scene> SceneCache::prepared(const std::string& path, const RenderSettings& settings) {
   // The rebasing point depends only on the origin mode and, for the camera
-  // origin, on the eye (given, or the file's camera).
+  // origin, on the eye (given, or the file's chosen camera).
   std::string key = path + (settings.renderOrigin == RenderOrigin::World ? "\x1fworld"
                                                                          : "\x1f"
                                                                            "camera");
@@ -110,11 +110,18 @@ std::shared_ptr<const Scene> SceneCache::prepared(const std::string& path, const
                   overrides.eye->z);
     key += eye;
   }
+  // The chosen camera moves the eye; the kept lights change the scene.
+  if (overrides.camera)
+    key +=
+        "\x1f"
+        "camera " +
+        std::to_string(*overrides.camera);
+  key += "\x1flights " + settings.lights;
   if (auto scene = prepared_.find(key)) return scene;
-  // A copy of the loaded scene rebased as loadSceneForRender rebases a
+  // A copy of the loaded scene prepared as loadSceneForRender prepares a
   // freshly loaded one: rebaseScene rounds again from worldPositions.
   Scene scene = *loaded(path);
-  applyRenderOrigin(scene, settings.renderOrigin, overrides);
+  prepareSceneForRender(scene, settings);
   auto shared = std::make_shared<const Scene>(std::move(scene));
   prepared_.insert(key, shared);
   return shared;
@@ -170,8 +177,11 @@ RenderRun renderPrepared(PreparedFrame& frame) {
   return run;
 }
 
-nlohmann::ordered_json sceneInfoJson(const Scene& scene, int width, int height) {
-  const Camera camera = makeCamera(scene, {}, width, height);
+namespace {
+
+// A camera as the page orbits it: eye, target and up (target: the eye
+// moved along the view direction to the depth of the bounds' centre).
+nlohmann::ordered_json orbitCameraJson(const Scene& scene, const Camera& camera) {
   const glm::dvec3 eye = camera.eye() + scene.origin, forward = camera.forward();
   const glm::dvec3 up = glm::normalize(glm::dvec3(camera.worldFromView[1]));
   // Orbit around the bounds' centre as seen along the view direction.
@@ -181,9 +191,42 @@ nlohmann::ordered_json sceneInfoJson(const Scene& scene, int width, int height) 
   if (!(distance > 1e-9 * size)) distance = size > 0.0 ? size : 1.0;
   const glm::dvec3 target = eye + forward * distance;
   auto vec = [](const glm::dvec3& v) { return nlohmann::ordered_json::array({v.x, v.y, v.z}); };
+  return {{"origin", camera.origin},
+          {"projection", camera.projection == Projection::Perspective ? "perspective" : "orthographic"},
+          {"yfovDegrees", camera.yfov * 180.0 / 3.14159265358979323846},
+          {"eye", vec(eye)},
+          {"target", vec(target)},
+          {"up", vec(up)}};
+}
+
+}  // namespace
+
+nlohmann::ordered_json sceneInfoJson(const Scene& scene, int width, int height) {
+  auto vec = [](const glm::dvec3& v) { return nlohmann::ordered_json::array({v.x, v.y, v.z}); };
   nlohmann::ordered_json bounds = nullptr;
   if (!scene.bounds.empty())
     bounds = {vec(scene.bounds.lo + scene.origin), vec(scene.bounds.hi + scene.origin)};
+  // The file's camera nodes in walk order (--camera N); a singular one
+  // (makeCamera refuses it) is listed without a view.
+  nlohmann::ordered_json cameras = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    CameraOverrides pick;
+    pick.camera = i;
+    nlohmann::ordered_json c;
+    try {
+      c = orbitCameraJson(scene, makeCamera(scene, pick, width, height));
+    } catch (const InputError& e) {
+      c = {{"origin", scene.cameras[i].origin}, {"error", e.message()}};
+    }
+    c["index"] = i;
+    cameras.push_back(c);
+  }
+  nlohmann::ordered_json lights = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    lights.push_back({{"index", i},
+                      {"name", scene.lights[i].name},
+                      {"type", toString(scene.lights[i].type)},
+                      {"node", scene.lights[i].node}});
   return {{"schema", "rastray.serve.scene"},
           {"version", 1},
           {"scene", scene.path},
@@ -191,15 +234,11 @@ nlohmann::ordered_json sceneInfoJson(const Scene& scene, int width, int height) 
           {"instances", scene.instances.size()},
           {"materials", scene.materials.size()},
           {"lights", scene.lights.size()},
+          {"lightList", lights},
           {"bounds", bounds},
-          {"size", size},
-          {"camera",
-           {{"origin", camera.origin},
-            {"projection", camera.projection == Projection::Perspective ? "perspective" : "orthographic"},
-            {"yfovDegrees", camera.yfov * 180.0 / 3.14159265358979323846},
-            {"eye", vec(eye)},
-            {"target", vec(target)},
-            {"up", vec(up)}}}};
+          {"size", scene.bounds.empty() ? 1.0 : glm::length(scene.bounds.hi - scene.bounds.lo)},
+          {"camera", orbitCameraJson(scene, makeCamera(scene, {}, width, height))},
+          {"cameras", cameras}};
 }
 
 }  // namespace rastray::serve

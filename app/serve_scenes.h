@@ -123,7 +123,9 @@ RenderRun renderPrepared(PreparedFrame& frame);
 // What the page needs to know of a scene before rendering it (schema
 // rastray.serve.scene): counts, bounds, and its camera at the given size
 // as eye, target and up (target: the eye moved along the view direction
-// to the depth of the bounds' centre, the point orbiting turns around).
+// to the depth of the bounds' centre, the point orbiting turns around);
+// likewise every camera node of the file ("cameras", --camera N), and the
+// lights by index, name and type ("lightList", --lights).
 nlohmann::ordered_json sceneInfoJson(const Scene& scene, int width, int height);
 
 }  // namespace rastray::serve

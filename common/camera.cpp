@@ -106,7 +106,22 @@ Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int widt
   if (width < 1 || height < 1)
     badOption("--size",
               "image size " + std::to_string(width) + "x" + std::to_string(height) + " must be at least 1x1");
-  const CameraModel model = scene.camera ? *scene.camera : defaultCameraModel(scene);
+  CameraModel model;
+  if (overrides.camera) {
+    const size_t n = *overrides.camera, count = scene.cameras.size();
+    if (n >= count)
+      badOption("--camera", "camera " + std::to_string(n) + " does not exist: the scene has " +
+                                std::to_string(count) + " camera node" + (count == 1 ? "" : "s"));
+    model = scene.cameras[n];
+    // The loader checks the first camera only (Scene::cameras).
+    const glm::dmat4& w = model.worldFromCamera;
+    if (glm::length(glm::cross(glm::dvec3(w[0]), glm::dvec3(w[1]))) == 0.0 ||
+        glm::length(glm::dvec3(w[2])) == 0.0)
+      badOption("--camera",
+                "camera " + std::to_string(n) + " (" + model.origin + "): its world matrix is singular");
+  } else {
+    model = scene.camera ? *scene.camera : defaultCameraModel(scene);
+  }
 
   Camera camera;
   camera.projection = model.projection;

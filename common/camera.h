@@ -26,6 +26,7 @@ enum class RenderOrigin {
 const char* toString(RenderOrigin origin);
 
 struct CameraOverrides {
+  std::optional<size_t> camera;  // Scene::cameras index (--camera N); the others apply on top
   std::optional<glm::dvec3> eye;
   std::optional<glm::dvec3> target;
   std::optional<glm::dvec3> up;
@@ -134,10 +135,11 @@ void applyRenderOrigin(Scene& scene, RenderOrigin mode, const CameraOverrides& o
 // The default camera of SPEC §2 for a scene (used when it has none).
 CameraModel defaultCameraModel(const Scene& scene);
 
-// Binds the scene's camera (or the default) to an image size and applies
-// the overrides. Throws InputError (file "command line") for impossible
-// settings: znear <= 0, zfar <= znear, yfov outside (0°, 180°), eye equal
-// to target, up parallel to the view direction, or a size below 1×1.
+// Binds the scene's camera (or the default; with overrides.camera, that
+// camera of Scene::cameras) to an image size and applies the overrides.
+// Throws InputError (file "command line") for impossible settings: a camera
+// index out of range or with a singular world matrix, znear <= 0, zfar <= znear, yfov outside (0°, 180°), eye
+// equal to target, up parallel to the view direction, or a size below 1×1.
 Camera makeCamera(const Scene& scene, const CameraOverrides& overrides, int width, int height);
 
 }  // namespace rastray

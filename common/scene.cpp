@@ -39,6 +39,7 @@ void rebaseScene(Scene& scene, const glm::dvec3& origin) {
   scene.bounds = bounds;
   for (Light& light : scene.lights) light.position -= shift;
   if (scene.camera) scene.camera->worldFromCamera[3] -= glm::dvec4(shift, 0.0);
+  for (CameraModel& camera : scene.cameras) camera.worldFromCamera[3] -= glm::dvec4(shift, 0.0);
   for (Instance& inst : scene.instances) {
     inst.degenerateCount = 0;
     for (uint32_t t = 0; t < inst.triangleCount; ++t)

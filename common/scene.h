@@ -195,6 +195,10 @@ struct Scene {
   std::vector<TextureImage> images;
   std::vector<Light> lights;
   std::optional<CameraModel> camera;  // first camera node in walk order
+  // Every camera node in walk order (cameras[0] is `camera`), for --camera N.
+  // Only the first is checked at load; makeCamera refuses a chosen later one
+  // whose world matrix is singular.
+  std::vector<CameraModel> cameras;
 
   Bounds bounds;  // world bounds of all instance vertices
   SceneFileStats stats;

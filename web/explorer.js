@@ -16,7 +16,8 @@ const state = {
   swipeWith: 'raytrace',
   size: [640, 480],
   options: {}, // render option name -> value, only those set away from the default
-  camera: null, // null: the scene's camera; else {eye, target, up}
+  camera: null, // null: the chosen file camera; else {eye, target, up} (given on top of it)
+  cameraIndex: null, // the file camera (--camera N); null: the first (the default)
   sceneInfo: null,
 };
 let optionTable = [];
@@ -75,6 +76,7 @@ function renderQuery(all, renderer, overrides) {
   q.set('scene', state.scene);
   if (!all) q.set('renderer', renderer);
   q.set('size', state.size.join(','));
+  if (state.cameraIndex !== null) q.set('camera', String(state.cameraIndex));
   if (state.camera) {
     for (const k of ['eye', 'target', 'up']) q.set(k, state.camera[k].map(fmt).join(','));
   }
@@ -381,9 +383,17 @@ function drawRays(rays, x, y) {
 }
 
 // ---- camera: orbit, pan, zoom ----------------------------------------------
+// The file camera chosen (its view as /api/scene describes it), or the
+// scene's default camera.
+function chosenCamera() {
+  const cams = state.sceneInfo.cameras || [];
+  const c = state.cameraIndex !== null ? cams[state.cameraIndex] : null;
+  return c && c.eye ? c : state.sceneInfo.camera;
+}
+
 function currentCamera() {
   if (state.camera) return state.camera;
-  const c = state.sceneInfo.camera;
+  const c = chosenCamera();
   return {eye: c.eye.slice(), target: c.target.slice(), up: c.up.slice()};
 }
 
@@ -406,7 +416,7 @@ function pan(dx, dy) {
   const right = norm(cross(forward, cam.up));
   const up = cross(right, forward);
   const distance = Math.hypot(...sub(cam.eye, cam.target));
-  const yfov = (state.sceneInfo.camera.yfovDegrees || 45) * Math.PI / 180;
+  const yfov = (chosenCamera().yfovDegrees || 45) * Math.PI / 180;
   const perPixel = 2 * distance * Math.tan(yfov / 2) / $('image-a').getBoundingClientRect().height;
   const move = add(mul(right, -dx * perPixel), mul(up, dy * perPixel));
   state.camera = {eye: add(cam.eye, move), target: add(cam.target, move), up: cam.up};
@@ -492,6 +502,10 @@ function readControls() {
   const bias = controls().filter((c) => c.dataset.option === 'shadow-bias').map((c) => c.value);
   if (bias.every((v) => v !== '')) o['shadow-bias'] = bias.join(',');
   if (!$('secondary').checked) o['max-depth'] = '0';
+  if (state.sceneInfo) { // the checkboxes exist once the scene is known
+    const lights = readLights();
+    if (lights === null) delete o.lights; else o.lights = lights;
+  }
   for (const [k, v] of Object.entries(o)) {
     const info = optionInfo(k);
     if (v === '' || (info && info.default === v)) delete o[k];
@@ -572,21 +586,73 @@ function readUrl(params, scenes) {
     const vec = (k) => params.get(k).split(',').map(Number);
     state.camera = {eye: vec('eye'), target: vec('target'), up: vec('up')};
   }
+  if (/^\d+$/.test(params.get('camera') || '')) state.cameraIndex = Number(params.get('camera'));
   for (const info of optionTable) {
-    if (params.has(info.name) && !['size', 'eye', 'target', 'up'].includes(info.name)) {
+    if (params.has(info.name) && !['size', 'eye', 'target', 'up', 'camera'].includes(info.name)) {
       state.options[info.name] = params.get(info.name);
     }
   }
 }
 
+// ---- lights: one checkbox per light of the scene (--lights) -------------------
+// The --lights value the checkboxes say: null when all are on (the default),
+// 'none' when all are off, else the indices kept, e.g. '0,2'.
+function readLights() {
+  const boxes = Array.from(document.querySelectorAll('#lights-list input'));
+  const kept = boxes.filter((b) => b.checked).map((b) => b.dataset.light);
+  if (kept.length === boxes.length) return null;
+  return kept.length === 0 ? 'none' : kept.join(',');
+}
+
+function writeLights() {
+  const list = $('lights-list');
+  const value = state.options.lights || 'all';
+  const kept = value === 'all' || value === 'none' ? null : value.split(',');
+  const lights = state.sceneInfo.lightList || [];
+  list.replaceChildren();
+  if (lights.length === 0) {
+    const p = document.createElement('p');
+    p.className = 'hint';
+    p.textContent = 'The scene has no lights: the eye light shines.';
+    list.append(p);
+  }
+  for (const l of lights) {
+    const box = document.createElement('input');
+    box.type = 'checkbox';
+    box.dataset.light = String(l.index);
+    box.checked = value === 'all' || (kept !== null && kept.includes(String(l.index)));
+    box.addEventListener('change', settingsChanged);
+    const label = document.createElement('label');
+    label.append(box, ' ' + l.index + ': ' + (l.name || '(unnamed)') + ' (' + l.type + ')');
+    list.append(label);
+  }
+}
+
+// ---- the scene ----------------------------------------------------------------
+// The camera select: every camera node of the file (--camera N; the first
+// is the default and needs no option), or the default camera of a file
+// without one; 'moved' once the view is dragged away from it.
+function writeCameraPick() {
+  const pick = $('camera-pick');
+  const cams = state.sceneInfo.cameras || [];
+  const options = cams.length === 0 ? [new Option(state.sceneInfo.camera.origin, 'scene')]
+    : cams.map((c) => {
+      const o = new Option('camera ' + c.index + ': ' + c.origin + (c.error ? ' (' + c.error + ')' : ''),
+                           c.index === 0 ? 'scene' : String(c.index));
+      o.disabled = !!c.error;
+      return o;
+    });
+  pick.replaceChildren(...options, new Option('moved (drag, pan, zoom)', 'moved'));
+  pick.value = state.camera ? 'moved' : state.cameraIndex ? String(state.cameraIndex) : 'scene';
+}
+
 async function loadScene(keepCamera) {
   const q = new URLSearchParams({scene: state.scene, size: state.size.join(',')});
   state.sceneInfo = await getJson('/api/scene?' + q.toString());
-  if (!keepCamera) state.camera = null;
-  const pick = $('camera-pick');
-  pick.replaceChildren(new Option(state.sceneInfo.camera.origin, 'scene'),
-                       new Option('moved (drag, pan, zoom)', 'moved'));
-  pick.value = state.camera ? 'moved' : 'scene';
+  if (!keepCamera) { state.camera = null; state.cameraIndex = null; }
+  if (state.cameraIndex !== null && !(state.cameraIndex < (state.sceneInfo.cameras || []).length)) state.cameraIndex = null;
+  writeCameraPick();
+  writeLights();
 }
 
 function bindEvents() {
@@ -597,11 +663,17 @@ function bindEvents() {
   $('scene').addEventListener('change', async () => {
     state.scene = $('scene').value;
     clearExplain();
+    delete state.options.lights; // another scene's light indices
     await loadScene(false);
     requestFrame(false);
   });
   $('camera-pick').addEventListener('change', () => {
-    if ($('camera-pick').value === 'scene') { state.camera = null; clearExplain(); requestFrame(false); }
+    const value = $('camera-pick').value;
+    if (value === 'moved') return;
+    state.camera = null;
+    state.cameraIndex = value === 'scene' ? null : Number(value);
+    clearExplain();
+    requestFrame(false);
   });
   $('swipe').addEventListener('input', applySwipe);
   $('copy').addEventListener('click', () => navigator.clipboard.writeText($('command').textContent));
@@ -710,7 +782,7 @@ async function init() {
     updateApplicability();
     if (params.get('selftest')) runSelftest(params.get('selftest'));
     if (!state.scene) { setStatus('no scene: start rastray serve with a scene or --root', true); return; }
-    await loadScene(!!state.camera);
+    await loadScene(!!state.camera || state.cameraIndex !== null);
     readControls();
     requestFrame(false);
   } catch (e) {

@@ -1,7 +1,7 @@
 // Step 4 of loading (loader.cpp): the checked JSON and tinygltf's buffers
 // and images → the flattened Scene. Walks the node trees from the scene's
 // roots, flattens every triangle primitive into an instance with world-space
-// vertices, and reads materials, textures, the first camera and the lights.
+// vertices, and reads materials, textures, the cameras and the lights.
 #include "common/gltf/scene_builder.h"
 
 #include <algorithm>
@@ -586,12 +586,14 @@ void SceneBuilder::appendTriangles(Instance& inst, const json& prim, const std::
 
 void SceneBuilder::addCamera(size_t node, const glm::dmat4& world) {
   ++scene_.stats.cameraNodes;
-  if (scene_.camera) return;  // the first camera node in walk order wins (SPEC §2)
   const size_t index = array("nodes")[node].at("camera").get<size_t>();
   const json& c = array("cameras")[index];
   const std::string e = "node " + std::to_string(node);
-  if (glm::length(glm::cross(glm::dvec3(world[0]), glm::dvec3(world[1]))) == 0.0 ||
-      glm::length(glm::dvec3(world[2])) == 0.0)
+  // The first camera node in walk order is the scene's camera (SPEC §2) and
+  // must be usable; later ones are kept for --camera N, which checks its own.
+  const bool first = !scene_.camera;
+  if (first && (glm::length(glm::cross(glm::dvec3(world[0]), glm::dvec3(world[1]))) == 0.0 ||
+                glm::length(glm::dvec3(world[2])) == 0.0))
     fail(e, "the camera's world matrix is singular");
   CameraModel cam;
   cam.worldFromCamera = world;
@@ -613,7 +615,8 @@ void SceneBuilder::addCamera(size_t node, const glm::dmat4& world) {
   const std::string name = get<std::string>(array("nodes")[node], "name", "");
   cam.origin = "node " + std::to_string(node) + (name.empty() ? "" : " '" + name + "'") + " (camera " +
                std::to_string(index) + ")";
-  scene_.camera = cam;
+  if (first) scene_.camera = cam;
+  scene_.cameras.push_back(cam);
 }
 
 void SceneBuilder::addLight(size_t node, const glm::dmat4& world) {

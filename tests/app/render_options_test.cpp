@@ -41,6 +41,7 @@ struct Expected {
 };
 
 const std::vector<Expected> kExpected = {
+    {"--camera", kAllRenderers, OptionCondition::Always, {"0"}},
     {"--eye", kAllRenderers, OptionCondition::Always, {"0", "0", "3"}},
     {"--target", kAllRenderers, OptionCondition::Always, {"0", "0", "0"}},
     {"--up", kAllRenderers, OptionCondition::Always, {"0", "1", "0"}},
@@ -54,6 +55,7 @@ const std::vector<Expected> kExpected = {
     {"--max-memory", kAllRenderers, OptionCondition::Always, {"8G"}},
     {"--texture-filter", kAllRenderers, OptionCondition::Always, {"nearest"}},
     {"--origin", kAllRenderers, OptionCondition::Always, {"world"}},
+    {"--lights", kAllRenderers, OptionCondition::Always, {"none"}},
     {"--cull", kAllRenderers, OptionCondition::Always, {"back"}},
     {"--shadows", kAllRenderers, OptionCondition::Always, {}},  // value: see valueFor
     {"--depth-format", kRaster | kHybrid, OptionCondition::Always, {"float"}},

@@ -282,6 +282,11 @@ TEST_F(ServeTest, UnknownParameterGets400) {
       {"/api/image?" + cornell() + "&debug-pixel=1,1", "debug-pixel: set by the server"},
       {"/api/options?verbose=1", "unknown parameter 'verbose'"},
       {"/api/scene?" + cornell() + "&spp=4", "unknown parameter 'spp'"},
+      // One value with commas of its own reaches --lights whole.
+      {"/api/image?" + cornell() + "&lights=0,3", "lights: light 3 does not exist: the scene has 1 light"},
+      {"/api/image?" + cornell() + "&lights=on", "lights: 'on' is not all, none or"},
+      {"/api/image?" + cornell() + "&camera=1",
+       "camera: camera 1 does not exist: the scene has 1 camera node"},
   };
   for (const auto& [target, message] : cases) {
     const auto r = get(target);
@@ -289,6 +294,23 @@ TEST_F(ServeTest, UnknownParameterGets400) {
     EXPECT_EQ(r->status, 400) << target;
     EXPECT_NE(r->body.find(message), std::string::npos) << target << " -> " << r->body;
   }
+}
+
+// The page's lights and camera controls are built from /api/scene.
+TEST_F(ServeTest, SceneInfoListsLightsAndCameras) {
+  const auto r = get("/api/scene?" + cornell() + "&size=40,30");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json j = json::parse(r->body);
+  ASSERT_EQ(j["lightList"].size(), 1u);
+  EXPECT_EQ(j["lightList"][0]["index"], 0);
+  EXPECT_EQ(j["lightList"][0]["name"], "CeilingLight");
+  EXPECT_EQ(j["lightList"][0]["type"], "point");
+  ASSERT_EQ(j["cameras"].size(), 1u);
+  EXPECT_EQ(j["cameras"][0]["index"], 0);
+  // The first camera node is the default camera.
+  for (const char* key : {"origin", "eye", "target", "up", "yfovDegrees"})
+    EXPECT_EQ(j["cameras"][0][key], j["camera"][key]) << key;
 }
 
 TEST_F(ServeTest, OnlyNamedScenesAndFilesUnderTheRootCanBeOpened) {
@@ -350,6 +372,8 @@ TEST_F(ServeTest, SettingsRoundTripThroughTheCommandLine) {
       "&renderer=hybrid&size=48,40&shadows=none&max-depth=0&wireframe=on&halo=on",
       "&renderer=raytrace&size=50,30&spp=2&max-depth=0&origin=world&eye=1.5,0.25,3&target=0,0,0&up=0,1,0",
       "&renderer=raytrace&size=40,30&transparency-cutoff=0&ray-offset=float-ulps&no-packets=on&yfov=60",
+      "&renderer=hybrid&size=48,40&lights=none&camera=0",
+      "&renderer=raster&size=40,30&lights=0&camera=0&eye=0.3,0.1,3&target=0,0,0&up=0,1,0",
   };
   int index = 0;
   for (const std::string& s : settings) {
