@@ -144,6 +144,11 @@ ExrHeaderFacts checkExrHeaders(const std::string& path) {
                       h = int64_t(readI32(box + 12)) - readI32(box + 4) + 1;
         facts.dataPixels = w > 0 && h > 0 ? uint64_t(w) * uint64_t(h) : 0;
       }
+      if (part == 0 && name == "tiles" && type == "tiledesc") {
+        unsigned char tiles[8];
+        if (!in.read(reinterpret_cast<char*>(tiles), 8)) throw truncated();
+        facts.tilePixels = uint64_t(uint32_t(readI32(tiles))) * uint32_t(readI32(tiles + 4));
+      }
       if (part == 0 && name == "type" && type == "string" && size >= 4) {
         char kind[4];
         if (!in.read(kind, 4)) throw truncated();

@@ -25,6 +25,7 @@ struct ExrHeaderFacts {
   uint64_t fileSize = 0;
   uint64_t dataPixels = 0;  // 0: no valid dataWindow (OpenEXR then refuses the file)
   bool deep = false;        // the "non-image" flag, or a part type "deepscanline"/"deeptile"
+  uint64_t tilePixels = 0;  // x size times y size of a tiled part's tiles; 0: scan lines
 };
 ExrHeaderFacts checkExrHeaders(const std::string& path);
 

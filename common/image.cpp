@@ -145,6 +145,16 @@ std::unique_ptr<OIIO::ImageInput> openExr(const std::string& path, uint64_t maxB
                      "deep data window of " + std::to_string(facts.dataPixels) +
                          " pixels cannot be stored in " + std::to_string(facts.fileSize) +
                          " bytes (at most " + std::to_string(kMaxDeepPixelsPerByte) + " pixels a byte)");
+  // OpenEXR allocates whole tiles for a tiled file, however small the
+  // image: a 497-byte file with 4 x 16,776,964-pixel tiles had it allocate
+  // 1.4 GB. Tiles larger than the image are legal (64 x 64 tiles on a
+  // smaller image are common), so the bound is the larger of the data
+  // window and 2^20 pixels.
+  if (facts.tilePixels > std::max(facts.dataPixels, uint64_t(1) << 20))
+    throw InputError(path, "header",
+                     "tiles of " + std::to_string(facts.tilePixels) +
+                         " pixels are larger than the data window (" + std::to_string(facts.dataPixels) +
+                         " pixels) and 2^20 pixels");
   if (facts.dataPixels > maxBytes / 4)
     throw InputError(path, "",
                      "reading it needs more than " + std::to_string(facts.dataPixels) + " x 4 bytes (its " +

@@ -27,7 +27,7 @@ while [ $# -gt 0 ]; do
       shift 2
       ;;
     --seconds=*) seconds="${1#--seconds=}"; shift ;;
-    -h | --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h | --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *)
       case " ${all_targets[*]} " in
@@ -48,7 +48,7 @@ CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DRASTRAY
 cmake --build "$build" -j"${FUZZ_BUILD_JOBS:-2}" --target "${targets[@]}" >/dev/null
 
 summary="$build/fuzz-summary.csv"
-echo "target,seconds,executions,exec_per_sec,cov,ft,corpus_units,corpus_bytes,peak_rss_mb,result,crash_file" >"$summary"
+echo "target,seconds,executions,exec_per_sec,cov,ft,corp,folder_files,folder_bytes,peak_rss_mb,result,crash_file" >"$summary"
 failed=0
 for t in "${targets[@]}"; do
   corpus="$build/corpus/$t"
@@ -76,6 +76,9 @@ for t in "${targets[@]}"; do
   last=$(grep -E '^#[0-9]+' "$log" | tail -n 1 || true)
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$last")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$last")
+  # libFuzzer's corpus (the inputs it keeps, "corp: U/SIZE") and the
+  # scratch folder (everything written to it, by this run and earlier ones).
+  corp=$(sed -n 's/.* corp: \([0-9]*\/[0-9]*[a-zA-Z]*\).*/\1/p' <<<"$last")
   units=$(ls "$corpus" | wc -l)
   bytes=$(du -sb "$corpus" | cut -f1)
   crash=$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "$log" | tail -n 1)
@@ -86,12 +89,12 @@ for t in "${targets[@]}"; do
     failed=1
   fi
   echo "fuzz: $t: $result; ${executions:-?} executions in ${duration} s (${rate:-?}/s), cov ${cov:-?}," \
-    "ft ${ft:-?}, corpus $units files / $bytes bytes, peak RSS ${rss:-?} MB"
+    "ft ${ft:-?}, corp ${corp:-?} (folder: $units files, $bytes bytes), peak RSS ${rss:-?} MB"
   if [ "$result" != clean ]; then
     grep -E '^(==[0-9]+==ERROR|SUMMARY|rastray: internal)|runtime error|terminate called|uncaught' "$log" | head -n 5 || true
     echo "fuzz: $t: crash input: ${crash:-see $artifacts/ and $log}"
   fi
-  echo "$t,$seconds,${executions},${rate},${cov},${ft},$units,$bytes,${rss},$result,${crash}" >>"$summary"
+  echo "$t,$seconds,${executions},${rate},${cov},${ft},${corp},$units,$bytes,${rss},$result,${crash}" >>"$summary"
 done
 echo "fuzz: summary in $summary"
 exit "$failed"

@@ -86,6 +86,14 @@ TEST(FuzzRegressions, ExrDeepDataWindowTheFileCannotHold) {
                        [](const std::string& p) { isDeepExr(p); });
 }
 
+// A 497-byte tiled file whose tiles are 4 x 16,776,964 pixels: OpenEXR
+// allocated 1.4 GB of tile buffers for a 6 x 4 image (found as a timeout:
+// freeing them under ASan took over 10 s).
+TEST(FuzzRegressions, ExrTilesFarLargerThanTheImage) {
+  expectRefusedCheaply("exr-tiles-4x16776964.exr", "are larger than the data window",
+                       [](const std::string& p) { readExr(p); });
+}
+
 // The readers' estimate: a file within the format's bounds whose windows
 // need more than the caller allows is refused before decoding.
 TEST(FuzzRegressions, ExrReadLimitRefusesBeforeDecoding) {
