@@ -11,6 +11,7 @@
 #include "app/cli_options.h"
 #include "app/commands.h"
 #include "common/error.h"
+#include "common/memory_budget.h"
 #include "compare/compare_files.h"
 #include "compare/maps.h"
 
@@ -29,6 +30,7 @@ struct CompareCommandOptions {
   CLI::Option *minAgreementOption = nullptr, *maxGenuineOption = nullptr, *failRmsOption = nullptr;
   bool json = false;
   std::string heatmap, mismatchMap, depthMap;
+  std::string maxMemory;  // empty: MemoryBudget::machineDefault()
 };
 
 // Colour options asked of files without colour (a visibility export) are
@@ -63,6 +65,11 @@ int runCompare(const CompareCommandOptions& opt) {
   in.spp = opt.spp;
   in.depthFormat = *parseStoredDepthFormat(opt.depthFormat);  // CLI11 checked the spelling
   in.edgeDistance = opt.edgeDistance;
+  // Both files are in memory at once: each may take half the budget
+  // (estimated from its header before decoding, common/image.h).
+  const MemoryBudget budget =
+      opt.maxMemory.empty() ? MemoryBudget::machineDefault() : MemoryBudget::parse(opt.maxMemory);
+  in.maxImageBytes = budget.bytes / 2;
   const CompareResult result = compareFiles(in);
 
   Thresholds t;
@@ -124,6 +131,9 @@ CommandRunner addCompareCommand(CLI::App& app) {
   cmd->add_option("--mismatch-map", opt->mismatchMap,
                   "Write the visibility-mismatch map coloured by class (PNG)");
   cmd->add_option("--depth-map", opt->depthMap, "Write the |dZ| heat map of agreeing hits (PNG)");
+  cmd->add_option("--max-memory", opt->maxMemory,
+                  "Refuse (exit 2) a file whose header says reading it needs more than half of this: bytes or "
+                  "K, M, G, T (default: 80% of physical memory)");
   return [opt, cmd]() -> int { return cmd->parsed() ? runCompare(*opt) : -1; };
 }
 

@@ -21,6 +21,7 @@
 
 #include "common/error.h"
 #include "common/exr_header.h"
+#include "common/memory_budget.h"
 #include "common/scene.h"
 
 namespace rastray {
@@ -462,16 +463,6 @@ bool isDeepExr(const std::string& path, uint64_t maxBytes) { return openExr(path
 
 namespace {
 
-uint64_t mulSat(uint64_t a, uint64_t b) {
-  uint64_t r;
-  return __builtin_mul_overflow(a, b, &r) ? UINT64_MAX : r;
-}
-
-uint64_t addSat(uint64_t a, uint64_t b) {
-  uint64_t r;
-  return __builtin_add_overflow(a, b, &r) ? UINT64_MAX : r;
-}
-
 // Upper bounds of what the readers below allocate for `spec`, per pixel of
 // the data window and of the display window (bytes, from the structures:
 // FlatImage holds a vec4, a float and two uint32 per pixel).
@@ -500,8 +491,8 @@ uint64_t deepReadBytes(const OIIO::ImageSpec& spec) {
 void checkReadBytes(const std::string& path, uint64_t needed, uint64_t maxBytes) {
   if (needed <= maxBytes) return;
   throw InputError(path, "",
-                   "reading it needs more than " + std::to_string(needed) + " bytes (its windows are " +
-                       "too large), above the limit of " + std::to_string(maxBytes));
+                   "reading it needs more than " + formatBytes(needed) + " (its windows are too large), above " +
+                       "the limit of " + formatBytes(maxBytes));
 }
 
 FlatImage readExrUnchecked(const std::string& path, uint64_t maxBytes) {

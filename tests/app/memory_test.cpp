@@ -81,6 +81,22 @@ TEST(MaxMemory, ASweepIsRefusedBeforeItsFirstCell) {
   std::filesystem::remove_all(dir);
 }
 
+// compare reads two files: each may take half of --max-memory, checked
+// from the header before decoding.
+TEST(MaxMemory, CompareRefusesFilesWhoseHeadersNeedTooMuch) {
+  const std::string dir = (std::filesystem::temp_directory_path() / "rastray-compare-memory").string();
+  std::filesystem::create_directories(dir);
+  const std::string a = dir + "/a.exr";
+  ASSERT_EQ(runRastray({"render", scene("three-triangles"), "--size", "64", "48", "-o", a}).status, 0);
+  auto r = runRastray({"compare", a, a, "--max-memory", "64K"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("a.exr: reading it needs more than"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("above the limit of 32.0 KiB"), std::string::npos) << r.err;
+  r = runRastray({"compare", a, a});
+  EXPECT_EQ(r.status, 0) << r.err;
+  std::filesystem::remove_all(dir);
+}
+
 // The estimate against the peak the process measured (getrusage), both in
 // `render --json`: an upper bound, and within 2.5× of the peak. Deep
 // output is the loosest (opaque coverage counted without occlusion).
