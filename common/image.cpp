@@ -491,8 +491,8 @@ uint64_t deepReadBytes(const OIIO::ImageSpec& spec) {
 void checkReadBytes(const std::string& path, uint64_t needed, uint64_t maxBytes) {
   if (needed <= maxBytes) return;
   throw InputError(path, "",
-                   "reading it needs more than " + formatBytes(needed) + " (its windows are too large), above " +
-                       "the limit of " + formatBytes(maxBytes));
+                   "reading it needs more than " + formatBytes(needed) +
+                       " (its windows are too large), above the limit of " + formatBytes(maxBytes));
 }
 
 FlatImage readExrUnchecked(const std::string& path, uint64_t maxBytes) {
