@@ -11,7 +11,6 @@
 #pragma once
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -19,6 +18,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
+#include "common/parallel.h"
 #include "raster/setup.h"
 
 namespace rastray {
@@ -98,7 +98,7 @@ std::vector<std::vector<uint32_t>> binTriangles(const TileGrid& grid, const Samp
   std::vector<uint32_t> slot(chunks * tiles, 0);  // counts, then each chunk's next slot per tile
   std::vector<uint32_t> fate(setups.size());      // its one tile, or kNotSelected, kSeveralTiles
   const auto forChunks = [&](auto&& body) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& r) {
+    parallelFor(tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t c = r.begin(); c != r.end(); ++c)
         body(slot.data() + c * tiles, c * perChunk, std::min(setups.size(), (c + 1) * perChunk));
     });

@@ -5,7 +5,6 @@
 #include "raster/rasterizer.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <memory>
@@ -13,6 +12,7 @@
 
 #include "common/error.h"
 #include "common/interrupt.h"
+#include "common/parallel.h"
 #include "raster/bin.h"
 #include "raster/clip.h"
 #include "raster/report.h"
@@ -128,7 +128,7 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   std::vector<std::vector<uint32_t>> deepCounts(deep.size());
   tbb::enumerable_thread_specific<ThreadCounters> counters;
   if (hits) hits->assign(size_t(camera.width) * size_t(camera.height) * size_t(options.spp), SampleHit{});
-  tbb::parallel_for(0, tiles.count(), [&](int tile) {
+  parallelFor(0, tiles.count(), [&](int tile) {
     // Ctrl-C (common/interrupt.h): the tiles not yet started are skipped,
     // and the unfinished image is thrown away below.
     if (interruptRequested()) return;

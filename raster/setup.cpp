@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "common/error.h"
+#include "common/parallel.h"
 #include "common/sampling.h"
 #include "raster/depth.h"
 
@@ -270,32 +271,52 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
   setups.reserve(inputs);
   size_t next = 0, appendedInputs = 0;
   const size_t tokens = 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
-  tbb::parallel_pipeline(
-      tokens, tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order,
-                                             [&](tbb::flow_control& fc) -> size_t {
-                                               if (next == chunks.size()) fc.stop();
-                                               return next++;
-                                             }) &
-                  tbb::make_filter<size_t, std::shared_ptr<ChunkOutput>>(
-                      tbb::filter_mode::parallel,
-                      [&](size_t c) {
-                        auto out = std::make_shared<ChunkOutput>();
-                        if (c >= chunks.size()) return out;
-                        out->inputs = chunks[c].count;
-                        setupChunk(scene, space, grid, depth, cull, filter, chunks[c], out.get());
-                        return out;
-                      }) &
-                  tbb::make_filter<std::shared_ptr<ChunkOutput>, void>(
-                      tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<ChunkOutput>& out) {
-                        appendedInputs += out->inputs;
-                        // Clipping made more pieces than the reserve foresaw: grow
-                        // once by what the remaining inputs can still need.
-                        if (setups.size() + out->setups.size() > setups.capacity())
-                          setups.reserve(setups.size() + out->setups.size() +
-                                         (inputs - std::min(inputs, appendedInputs)));
-                        setups.insert(setups.end(), out->setups.begin(), out->setups.end());
-                        add(out->counters, counters);
-                      }));
+  // A chunk's output waits in its slot from the parallel stage to the ordered
+  // one, which frees it: the stages pass only the chunk's index, and an
+  // exception frees what was in flight with the slots.
+  std::vector<std::unique_ptr<ChunkOutput>> outputs(chunks.size());
+  // TBB's ordering stated to ThreadSanitizer (common/parallel.h), as libtbb
+  // is not built for it: everything above happens before every stage call
+  // and every stage call before the return (PipelineEdges); the calls of a
+  // serial stage are ordered (edges through `next` and `setups`); a chunk's
+  // parallel stage happens before its ordered one (edge through its slot).
+  PipelineEdges edges;
+  const auto take = [&](tbb::flow_control& fc) -> size_t {
+    tsanAcquire(&next);
+    if (next == chunks.size()) fc.stop();
+    const size_t c = next++;
+    tsanRelease(&next);
+    return c;
+  };
+  const auto setUp = [&](size_t c) {
+    if (c >= chunks.size()) return c;
+    auto out = std::make_unique<ChunkOutput>();
+    out->inputs = chunks[c].count;
+    setupChunk(scene, space, grid, depth, cull, filter, chunks[c], out.get());
+    outputs[c] = std::move(out);
+    tsanRelease(&outputs[c]);
+    return c;
+  };
+  const auto append = [&](size_t c) {
+    if (c >= chunks.size()) return;
+    tsanAcquire(&outputs[c]);
+    tsanAcquire(&setups);
+    const std::unique_ptr<ChunkOutput> out = std::move(outputs[c]);
+    appendedInputs += out->inputs;
+    // Clipping made more pieces than the reserve foresaw: grow
+    // once by what the remaining inputs can still need.
+    if (setups.size() + out->setups.size() > setups.capacity())
+      setups.reserve(setups.size() + out->setups.size() + (inputs - std::min(inputs, appendedInputs)));
+    setups.insert(setups.end(), out->setups.begin(), out->setups.end());
+    add(out->counters, counters);
+    tsanRelease(&setups);
+  };
+  const auto filters = tbb::make_filter<void, size_t>(tbb::filter_mode::serial_in_order, edges.stage(take)) &
+                       tbb::make_filter<size_t, size_t>(tbb::filter_mode::parallel, edges.stage(setUp)) &
+                       tbb::make_filter<size_t, void>(tbb::filter_mode::serial_in_order, edges.stage(append));
+  edges.fork();
+  tbb::parallel_pipeline(tokens, filters);
+  edges.join();
   return setups;
 }
 

@@ -1,7 +1,6 @@
 #include "raster/shadow_map.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +8,7 @@
 
 #include "common/interrupt.h"
 #include "common/math_constants.h"
+#include "common/parallel.h"
 
 namespace rastray {
 
@@ -66,7 +66,7 @@ std::vector<Camera> cubeFaceCameras(const glm::dvec3& eye, int size, double znea
 std::vector<uint8_t> cubeFaceCandidates(const Scene& scene, const glm::dvec3& eye, double t, int size) {
   std::vector<uint8_t> mask(scene.triangles.size(), 0);
   const double wide = t * (1.0 + 4.0 / double(size));
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, mask.size()), [&](const tbb::blocked_range<size_t>& r) {
+  parallelFor(tbb::blocked_range<size_t>(0, mask.size()), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i != r.end(); ++i) {
       const glm::uvec3 idx = scene.triangles[i];
       const glm::dvec3 d[3] = {glm::dvec3(scene.positions[idx.x]) - eye,
@@ -168,7 +168,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
           return shader->coverageAlpha(surfaceAt(t, px, py, s), TextureFootprint{}) >= m.alphaCutoff;
         };
       std::vector<std::vector<Attenuation>> perTile(size_t(tiles.count()));
-      tbb::parallel_for(0, tiles.count(), [&](int tile) {
+      parallelFor(0, tiles.count(), [&](int tile) {
         if (interruptRequested()) return;  // Ctrl-C: thrown below
         DepthPassCounters dc;
         const TileRect rect = tiles.rect(tile);

@@ -22,12 +22,12 @@
 // the wall time of assembling the deep image (keepSamples only).
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 
 #include "common/interrupt.h"
+#include "common/parallel.h"
 #include "common/sampling.h"
 #include "raytrace/ray_caster_parts.h"
 
@@ -134,7 +134,7 @@ RenderOutput renderPrimaryVisibility(const CasterState& state) {
   }
   tbb::enumerable_thread_specific<TileScratch> scratch;
   const Clock::time_point start = Clock::now();
-  tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY), [&](const tbb::blocked_range<int>& range) {
+  parallelFor(tbb::blocked_range<int>(0, tilesX * tilesY), [&](const tbb::blocked_range<int>& range) {
     TileScratch& local = scratch.local();
     for (int t = range.begin(); t != range.end(); ++t) {
       // Ctrl-C (common/interrupt.h): the tiles not yet started are
@@ -238,7 +238,7 @@ DeepImage assembleDeepImage(int width, int height, int tileSize, int tilesX, con
   }
   image.offsets[pixels] = total;
   image.samples.resize(total);
-  tbb::parallel_for(size_t(0), deep.tiles.size(), [&](size_t t) {
+  parallelFor(size_t(0), deep.tiles.size(), [&](size_t t) {
     const int x0 = int(t % size_t(tilesX)) * tileSize, y0 = int(t / size_t(tilesX)) * tileSize;
     const int x1 = std::min(x0 + tileSize, width), y1 = std::min(y0 + tileSize, height);
     const std::vector<DeepSample>& buffer = deep.tiles[t];

@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 
-#include <tbb/parallel_for.h>
 #include "common/math_constants.h"
 
 #include <cmath>
@@ -17,6 +16,7 @@
 
 #include "common/error.h"
 #include "common/gltf/loader.h"
+#include "common/parallel.h"
 #include "common/sampling.h"
 #include "common/shading.h"
 #include "common/trace.h"
@@ -487,7 +487,7 @@ TEST(Hybrid, SecondaryRayInterfacesAreThreadSafeAndCounted) {
                                            glm::length(light - points[i].position));
   }
   std::vector<glm::vec3> parallelRadiance(points.size()), parallelShadow(points.size());
-  tbb::parallel_for(size_t(0), points.size(), [&](size_t i) {
+  parallelFor(size_t(0), points.size(), [&](size_t i) {
     parallelRadiance[i] = caster.radiance(points[i], directions[i], RayKind::Reflection, 1, 1.0f);
     parallelShadow[i] = caster.transmittance(points[i], 0, glm::normalize(light - points[i].position),
                                              glm::length(light - points[i].position));
