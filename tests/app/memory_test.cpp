@@ -101,6 +101,12 @@ TEST(MaxMemory, CompareRefusesFilesWhoseHeadersNeedTooMuch) {
 // `render --json`: an upper bound, and within 2.5× of the peak. Deep
 // output is the loosest (opaque coverage counted without occlusion).
 TEST(MaxMemory, TheEstimateBoundsTheMeasuredPeak) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  // The estimate sizes the program's own structures; a sanitizer build adds
+  // shadow memory, redzones and a free quarantine (measured: 1.1-1.5x the
+  // plain peak under ASan), which no estimate of the program can bound.
+  GTEST_SKIP() << "sanitizer build: its shadow memory and quarantine are not the renderer's";
+#endif
   const std::string dir = (std::filesystem::temp_directory_path() / "rastray-memory-peaks").string();
   std::filesystem::create_directories(dir);
   const std::vector<std::vector<std::string>> cases = {
