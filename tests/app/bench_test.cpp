@@ -12,6 +12,7 @@
 #include "app/stability_measure.h"
 #include "app/sweep_table.h"
 #include "tests/app/run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -147,7 +148,7 @@ TEST(BenchCommand, LastLineIsTheMedianFrame) {
 }
 
 TEST(BenchCommand, GeneratedTerrainHasTheTrianglesAsked) {
-  const std::string dir = testing::TempDir() + "/bench-terrain";
+  const std::string dir = test::scratchPath("bench-terrain");
   const test::CommandResult r = test::runRastray(
       {"bench", "terrain:2000", "--size", "80", "60", "--frames", "1", "--warmup", "0", "--work-dir", dir});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -158,7 +159,7 @@ TEST(BenchCommand, GeneratedTerrainHasTheTrianglesAsked) {
 // our median (a peer that is not built or installed is skipped with a
 // message; CI builds and installs both).
 TEST(BenchCommand, PeersPrintRatiosAndCsvRows) {
-  const std::string dir = testing::TempDir() + "/bench-peers";
+  const std::string dir = test::scratchPath("bench-peers");
   const std::string csv = dir + "/peers.csv";
   std::filesystem::remove_all(dir);
   for (const char* renderer : {"raster", "raytrace"}) {
@@ -170,7 +171,9 @@ TEST(BenchCommand, PeersPrintRatiosAndCsvRows) {
     EXPECT_TRUE(std::regex_search(r.out, std::regex("median frame: [0-9]+\\.[0-9]{3} ms\n$"))) << r.out;
     const bool skipped = r.out.find("skipped:") != std::string::npos;
     const char* peer = std::string(renderer) == "raster" ? "\nllvmpipe " : "\nembree viewer ";
-    if (!skipped) EXPECT_NE(r.out.find(peer), std::string::npos) << r.out;
+    if (!skipped) {
+      EXPECT_NE(r.out.find(peer), std::string::npos) << r.out;
+    }
   }
   std::ifstream f(csv);
   std::string header, row;

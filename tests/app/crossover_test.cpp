@@ -21,6 +21,7 @@
 #include "common/error.h"
 #include "common/scene.h"
 #include "run_command.h"
+#include "tests/test_files.h"
 #include "xml_check.h"
 
 namespace rastray::crossover {
@@ -28,22 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name)
-      : path(fs::temp_directory_path() / ("rastray-crossover-test-" + name)) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using test::slurp;
 
 TEST(Crossover, MeshesHaveExactlyTheTrianglesAskedFor) {
   for (const uint64_t t :
@@ -71,12 +57,12 @@ TEST(Crossover, MeshesHaveExactlyTheTrianglesAskedFor) {
 }
 
 TEST(Crossover, MeshesAreDeterministicAndBothVariantsShareThem) {
-  TempDir dir("deterministic");
-  crossoverScene(20'000, true, 16.0 / 9.0).writeGlb((dir.path / "a.glb").string());
-  crossoverScene(20'000, true, 16.0 / 9.0).writeGlb((dir.path / "b.glb").string());
-  const std::string a = readFile(dir.path / "a.glb");
+  const fs::path dir = test::scratchDir();
+  crossoverScene(20'000, true, 16.0 / 9.0).writeGlb((dir / "a.glb").string());
+  crossoverScene(20'000, true, 16.0 / 9.0).writeGlb((dir / "b.glb").string());
+  const std::string a = slurp(dir / "a.glb");
   EXPECT_GT(a.size(), 20'000u * 12);  // indices alone take 12 bytes a triangle
-  EXPECT_EQ(a, readFile(dir.path / "b.glb"));
+  EXPECT_EQ(a, slurp(dir / "b.glb"));
 
   const GltfScene lit = crossoverScene(20'000, true, 16.0 / 9.0),
                   unlit = crossoverScene(20'000, false, 16.0 / 9.0);
@@ -86,7 +72,7 @@ TEST(Crossover, MeshesAreDeterministicAndBothVariantsShareThem) {
   EXPECT_TRUE(unlit.lights.empty());
   EXPECT_NE(unlit.materials[0].emissive, glm::vec3(0.0f));
   // The loader reads exactly that many triangles back from the .glb.
-  EXPECT_EQ(loadScene((dir.path / "a.glb").string()).triangles.size(), 20'000u);
+  EXPECT_EQ(loadScene((dir / "a.glb").string()).triangles.size(), 20'000u);
 }
 
 // Every pixel sees the surface, at 16:9 and 4:3, at a coarse and a fine
@@ -94,11 +80,11 @@ TEST(Crossover, MeshesAreDeterministicAndBothVariantsShareThem) {
 // the row beyond it are not): the study measures full frames of triangles
 // that all cost work, not background.
 TEST(Crossover, TheSurfaceFillsTheViewWithItsTriangles) {
-  TempDir dir("fills");
+  const fs::path dir = test::scratchDir();
   for (const uint64_t t : {100ull, 1001ull, 50'000ull})
     for (const ImageSize size : {ImageSize{64, 36}, ImageSize{48, 36}}) {
       const std::string path =
-          (dir.path / ("s" + std::to_string(t) + "-" + std::to_string(size.width) + ".glb")).string();
+          (dir / ("s" + std::to_string(t) + "-" + std::to_string(size.width) + ".glb")).string();
       crossoverScene(t, false, double(size.width) / double(size.height)).writeGlb(path);
       for (const char* renderer : {"raster", "raytrace"}) {
         RenderSettings settings;
@@ -132,8 +118,8 @@ CrossoverOptions tinyStudy(const std::string& dir) {
 }
 
 TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
-  TempDir dir("tiny");
-  const CrossoverOptions options = tinyStudy(dir.path.string());
+  const fs::path dir = test::scratchDir();
+  const CrossoverOptions options = tinyStudy(dir.string());
   StudyMeta meta;
   const std::vector<CellResult> rows = measureCells(options, meta, {});
   writeCrossoverReport(options.reportDir, meta, rows);
@@ -150,7 +136,7 @@ TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
   }
 
   // CSV: the documented header, one line per row, as many fields as columns.
-  const std::string csv = readFile(dir.path / "crossover.csv");
+  const std::string csv = slurp(dir / "crossover.csv");
   std::istringstream lines(csv);
   std::string header, line;
   std::getline(lines, header);
@@ -165,7 +151,7 @@ TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
   EXPECT_EQ(count, 8);
 
   // JSON: schema, version, machine, one row per cell and a winner per cell.
-  const nlohmann::json j = nlohmann::json::parse(readFile(dir.path / "crossover.json"));
+  const nlohmann::json j = nlohmann::json::parse(slurp(dir / "crossover.json"));
   EXPECT_EQ(j.at("schema"), "rastray.crossover");
   EXPECT_EQ(j.at("version"), 1);
   EXPECT_EQ(j.at("threads"), 1);
@@ -183,20 +169,20 @@ TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
   // The JSON reads back to the same rows and files.
   StudyMeta readMeta;
   std::vector<CellResult> readRows;
-  readJson((dir.path / "crossover.json").string(), readMeta, readRows);
+  readJson((dir / "crossover.json").string(), readMeta, readRows);
   EXPECT_EQ(toCsv(readRows), toCsv(rows));
   EXPECT_EQ(toJson(readMeta, readRows), toJson(meta, rows));
   {
-    std::ofstream bad(dir.path / "other.json");
+    std::ofstream bad(dir / "other.json");
     bad << R"({"schema": "rastray.sweep", "version": 1})";
   }
-  EXPECT_THROW(readJson((dir.path / "other.json").string(), readMeta, readRows), InputError);
+  EXPECT_THROW(readJson((dir / "other.json").string(), readMeta, readRows), InputError);
 
   // Plots: valid XML, labelled axes, every cell placed (the winner maps).
   for (const char* file :
        {"crossover-shaded.svg", "crossover-visibility.svg", "crossover-time.svg", "crossover-memory.svg"}) {
     std::string error;
-    const std::vector<test::Element> elements = test::parseXml(readFile(dir.path / file), &error);
+    const std::vector<test::Element> elements = test::parseXml(slurp(dir / file), &error);
     EXPECT_TRUE(error.empty()) << file << ": " << error;
     std::string xTitle, yTitle;
     for (const test::Element& e : elements) {
@@ -211,7 +197,7 @@ TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
   const PlotRender shaded = renderPlot(plots[0].plot);
   EXPECT_EQ(shaded.drawn, 4u);
   EXPECT_EQ(shaded.skipped, 0u);
-  EXPECT_NE(readFile(dir.path / "index.html").find("<svg"), std::string::npos);
+  EXPECT_NE(slurp(dir / "index.html").find("<svg"), std::string::npos);
 
   // Peak memory grows with the triangle count, for each renderer and size.
   for (const CellResult& small : rows)
@@ -234,8 +220,8 @@ TEST(Crossover, CellsThatCannotRunAreRecorded) {
   // cannot say it ran out of memory; the plain build runs this test.
   GTEST_SKIP() << "RLIMIT_AS cannot simulate running out of memory under AddressSanitizer";
 #endif
-  TempDir dir("fail");
-  CrossoverOptions options = tinyStudy(dir.path.string());
+  const fs::path dir = test::scratchDir();
+  CrossoverOptions options = tinyStudy(dir.string());
   // Too little for the dynamic loader to map rastray's libraries: every cell
   // that runs fails for memory.
   options.childMemoryLimitBytes = 64ull << 20;
@@ -259,7 +245,7 @@ TEST(Crossover, CellsThatCannotRunAreRecorded) {
     }
   }
   writeCrossoverReport(options.reportDir, meta, rows);
-  EXPECT_NE(readFile(dir.path / "crossover.csv").find("skipped"), std::string::npos);
+  EXPECT_NE(slurp(dir / "crossover.csv").find("skipped"), std::string::npos);
   // The winner map still places every cell, as "neither renderer ran".
   const PlotRender map = renderPlot(crossoverPlots(meta, rows)[0].plot);
   EXPECT_EQ(map.drawn, 4u);

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -18,12 +19,7 @@ using test::runRastray;
 
 std::string scene(const char* name) { return std::string(RASTRAY_SCENES) + "/" + name + ".gltf"; }
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 // Every bundled scene: zero genuine mismatches between the rasterizer and
 // the ray caster and between hybrid and the ray caster, and hybrid shades

@@ -24,6 +24,7 @@
 #include "common/image.h"
 #include "common/interrupt.h"
 #include "tests/app/run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -33,12 +34,7 @@ using nlohmann::json;
 
 std::string scene(const char* name) { return std::string(RASTRAY_SCENES) + "/" + name + ".gltf"; }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 // Every file below `dir` whose name has the atomic writers' ".tmp." in it
 // (common/image.cpp temporaryPathFor).
@@ -63,8 +59,7 @@ FileStamp stampOf(const fs::path& p) {
 class Interrupt : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ =
-        testing::TempDir() + "/interrupt-" + ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    dir_ = test::scratchPath("out");
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

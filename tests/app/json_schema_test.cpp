@@ -10,6 +10,7 @@
 #include "app/stability.h"
 #include "app/stability_report.h"
 #include "tests/app/run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -36,8 +37,7 @@ nlohmann::json fileJson(const std::string& path) {
 class JsonSchema : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = testing::TempDir() + "/json-schema-" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    dir_ = test::scratchPath("out");
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
   }

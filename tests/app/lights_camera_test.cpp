@@ -14,6 +14,7 @@
 
 #include "common/image.h"
 #include "run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -35,7 +36,7 @@ json readJson(const std::string& path) {
 }
 
 std::string writeScene(const json& doc, const std::string& name) {
-  const std::string path = ::testing::TempDir() + "/" + name;
+  const std::string path = test::scratchPath(name);
   std::ofstream(path) << doc.dump();
   return path;
 }
@@ -64,7 +65,7 @@ std::string cornellWithTwoCameras() {
 
 FlatImage render(const std::string& scene, const std::string& name, const Args& extra,
                  json* report = nullptr) {
-  const std::string out = ::testing::TempDir() + "/lights-camera-" + name + ".exr";
+  const std::string out = test::scratchPath("lights-camera-" + name + ".exr");
   Args args = {"render", scene, "--size", "40", "30", "--spp", "4", "-o", out};
   args.insert(args.end(), extra.begin(), extra.end());
   if (report) args.push_back("--json");
@@ -121,7 +122,7 @@ TEST(Lights, KeepingTheOnlyLightIsTheDefault) {
 }
 
 TEST(Lights, BadListsAreRefused) {
-  const std::string out = ::testing::TempDir() + "/lights-bad.exr";
+  const std::string out = test::scratchPath("lights-bad.exr");
   for (const Args& bad : {Args{"--lights", "1"}, Args{"--lights", "0,3"}}) {
     const auto r = runRastray(Args{"render", kCornell, "--size", "8", "8", "-o", out} + bad);
     EXPECT_EQ(r.status, 2) << r.err;
@@ -180,7 +181,7 @@ TEST(Cameras, EveryCameraNodeCanBeChosen) {
 
 TEST(Cameras, AnIndexOutOfRangeIsRefused) {
   const std::string scene = cornellWithTwoCameras();
-  const std::string out = ::testing::TempDir() + "/camera-bad.exr";
+  const std::string out = test::scratchPath("camera-bad.exr");
   for (const Args& args : {Args{"render", scene, "--size", "8", "8", "-o", out, "--camera", "2"},
                            Args{"info", scene, "--camera", "2"}, Args{"info", kCornell, "--camera", "1"}}) {
     const auto r = runRastray(args);

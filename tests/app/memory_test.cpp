@@ -9,6 +9,7 @@
 #include <string>
 
 #include "run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -24,7 +25,7 @@ size_t lines(const std::string& text) {
 }
 
 TEST(MaxMemory, AnAbsurdRenderIsRefusedBeforeAllocating) {
-  const std::string out = (std::filesystem::temp_directory_path() / "rastray-absurd.exr").string();
+  const std::string out = test::scratchPath("absurd.exr");
   std::filesystem::remove(out);
   // 16384² × 64 spp with deep output: terabytes.
   const auto r = runRastray(
@@ -40,7 +41,7 @@ TEST(MaxMemory, AnAbsurdRenderIsRefusedBeforeAllocating) {
 }
 
 TEST(MaxMemory, TheLimitIsTheUsersToSet) {
-  const std::string out = (std::filesystem::temp_directory_path() / "rastray-limit.png").string();
+  const std::string out = test::scratchPath("limit.png");
   auto r =
       runRastray({"render", scene("cornell-box"), "--size", "64", "48", "--max-memory", "64M", "-o", out});
   EXPECT_EQ(r.status, 2) << r.err;
@@ -54,7 +55,7 @@ TEST(MaxMemory, TheLimitIsTheUsersToSet) {
 }
 
 TEST(MaxMemory, CrossvalIsRefusedUpFrontForItsThreeDeepFrames) {
-  const std::string dir = (std::filesystem::temp_directory_path() / "rastray-crossval-memory").string();
+  const std::string dir = test::scratchPath("crossval-memory");
   std::filesystem::remove_all(dir);
   // One deep frame fits 1 GiB; three do not.
   const auto r = runRastray({"crossval", scene("cornell-box"), "--size", "1600", "1200", "--spp", "8",
@@ -68,7 +69,7 @@ TEST(MaxMemory, CrossvalIsRefusedUpFrontForItsThreeDeepFrames) {
 }
 
 TEST(MaxMemory, ASweepIsRefusedBeforeItsFirstCell) {
-  const std::string dir = (std::filesystem::temp_directory_path() / "rastray-sweep-memory").string();
+  const std::string dir = test::scratchPath("sweep-memory");
   std::filesystem::remove_all(dir);
   // Cell 0 (1 spp) fits, cell 1 (64 spp) does not: nothing runs.
   const auto r = runRastray({"sweep", scene("cornell-box"), "--vary", "spp=1,64", "--size", "2000", "2000",
@@ -84,7 +85,7 @@ TEST(MaxMemory, ASweepIsRefusedBeforeItsFirstCell) {
 // compare reads two files: each may take half of --max-memory, checked
 // from the header before decoding.
 TEST(MaxMemory, CompareRefusesFilesWhoseHeadersNeedTooMuch) {
-  const std::string dir = (std::filesystem::temp_directory_path() / "rastray-compare-memory").string();
+  const std::string dir = test::scratchPath("compare-memory");
   std::filesystem::create_directories(dir);
   const std::string a = dir + "/a.exr";
   ASSERT_EQ(runRastray({"render", scene("three-triangles"), "--size", "64", "48", "-o", a}).status, 0);
@@ -107,7 +108,7 @@ TEST(MaxMemory, TheEstimateBoundsTheMeasuredPeak) {
   // plain peak under ASan), which no estimate of the program can bound.
   GTEST_SKIP() << "sanitizer build: its shadow memory and quarantine are not the renderer's";
 #endif
-  const std::string dir = (std::filesystem::temp_directory_path() / "rastray-memory-peaks").string();
+  const std::string dir = test::scratchPath("memory-peaks");
   std::filesystem::create_directories(dir);
   const std::vector<std::vector<std::string>> cases = {
       {scene("cornell-box"), "--renderer", "raster", "--size", "960", "540", "--spp", "8", "-o",

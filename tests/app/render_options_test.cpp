@@ -16,6 +16,7 @@
 #include "app/render_setup.h"
 #include "common/error.h"
 #include "run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -310,8 +311,7 @@ TEST(RenderOptionsCommand, AcceptedWhereTheyApply) {
                            Args{"--renderer", "raster", "--wireframe", "--halo", "--shadow-bias", "1", "1",
                                 "--depth-func", "lequal"}}) {
     const auto r = runRastray(
-        Args{"render", kScene, "-o", testing::TempDir() + "/render-options.png", "--size", "16", "12"} +
-        args);
+        Args{"render", kScene, "-o", test::scratchPath("render-options.png"), "--size", "16", "12"} + args);
     EXPECT_EQ(r.status, 0) << joined(args) << "\n" << r.err;
   }
   const auto r = runRastray({"crossval", kScene, "--size", "16", "12", "--no-packets", "--shadow-map-size",

@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -26,12 +27,7 @@ namespace fs = std::filesystem;
 
 std::string scenePath(const char* name) { return std::string(RASTRAY_SCENES) + "/" + name + ".gltf"; }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 fs::path freshDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("rastray-" + name + "-" + std::to_string(getpid()));

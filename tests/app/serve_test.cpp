@@ -16,6 +16,7 @@
 #include "app/serve_api.h"
 #include "app/serve_server.h"
 #include "run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -25,12 +26,7 @@ using nlohmann::json;
 
 std::string scenePath(const char* name) { return std::string(RASTRAY_SCENES) + "/" + name + ".gltf"; }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 // Width and height from a PNG's IHDR chunk (big-endian, bytes 16-23).
 std::pair<int, int> pngSize(const std::string& png) {

@@ -20,6 +20,7 @@
 #include "app/stability.h"
 #include "app/stability_report.h"
 #include "run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray::stability {
 namespace {
@@ -27,12 +28,7 @@ namespace {
 using nlohmann::json;
 using test::runRastray;
 
-std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 struct TempFolder {
   std::filesystem::path path;

@@ -23,6 +23,7 @@
 #include "common/error.h"
 #include "common/gltf/writer.h"
 #include "run_command.h"
+#include "tests/test_files.h"
 #include "xml_check.h"
 
 namespace rastray::sweep {
@@ -30,12 +31,7 @@ namespace {
 
 const std::string kScenes = RASTRAY_SCENES;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 // A fresh folder under the system temp dir, removed at the end of the test.
 struct TempDir {

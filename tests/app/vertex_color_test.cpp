@@ -12,6 +12,7 @@
 
 #include "common/image.h"
 #include "run_command.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -23,7 +24,7 @@ const std::string kScene = std::string(RASTRAY_SCENES) + "/vertex-colors.gltf";
 constexpr int kSize = 64;
 
 FlatImage render(const std::string& renderer) {
-  const std::string out = ::testing::TempDir() + "/vertex-colors-" + renderer + ".exr";
+  const std::string out = test::scratchPath("vertex-colors-" + renderer + ".exr");
   const auto r = runRastray({"render", kScene, "--renderer", renderer, "--size", std::to_string(kSize),
                              std::to_string(kSize), "--float", "-o", out});
   EXPECT_EQ(r.status, 0) << r.err;
@@ -126,7 +127,7 @@ TEST(InfoIgnored, ListsEachIgnoredFeatureWithItsCount) {
         {{"occlusionTexture", {{"index", 0}, {"extensions", transform}}},
          {"extensions", {{"KHR_materials_volume", {{"thicknessFactor", 1}}}}}},
         {{"occlusionTexture", {{"index", 0}}}}}}};
-  const std::string path = ::testing::TempDir() + "/ignored-features.gltf";
+  const std::string path = test::scratchPath("ignored-features.gltf");
   std::ofstream(path) << doc.dump();
 
   const auto text = runRastray({"info", path});

@@ -13,13 +13,12 @@
 #include "common/gltf/loader.h"
 #include "common/gltf/writer.h"
 #include "common/scene.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
 
-std::string tempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("rastray-writer-" + name)).string();
-}
+std::string tempPath(const std::string& name) { return test::scratchPath(name); }
 
 GltfScene texturedQuad() {
   GltfScene s;

@@ -13,6 +13,7 @@
 #include "common/error.h"
 #include "common/gltf/loader.h"
 #include "common/memory_budget.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -104,7 +105,7 @@ std::string instancingFile(const std::string& name, int64_t count, int primitive
   }
   doc["scenes"] = nlohmann::json::array({{{"nodes", roots}}});
   doc["scene"] = 0;
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  const std::string path = test::scratchPath(name);
   std::ofstream(path) << doc.dump();
   return path;
 }
@@ -182,7 +183,7 @@ TEST(SceneLoaderLimits, AnImageDeclaringAHugeCanvasIsRefusedFromItsHeader) {
   nlohmann::json doc;
   doc["asset"] = {{"version", "2.0"}};
   doc["images"] = nlohmann::json::array({{{"uri", "data:image/png;base64," + base64(png)}}});
-  const std::string path = (std::filesystem::temp_directory_path() / "rastray-huge-image.gltf").string();
+  const std::string path = test::scratchPath("huge-image.gltf");
   std::ofstream(path) << doc.dump();
   const std::string error = loadError(path, MemoryBudget::parse("2G"));
   EXPECT_NE(error.find(": image 0: decoding the images needs about"), std::string::npos) << error;

@@ -19,6 +19,7 @@
 #include "common/gltf/loader.h"
 #include "common/math_constants.h"
 #include "common/scene.h"
+#include "tests/test_files.h"
 
 // Readable failure messages for the GLM vectors compared below.
 namespace glm {
@@ -87,7 +88,7 @@ void expectVec3Near(const glm::dvec3& actual, const glm::dvec3& expected, double
 // not stand in for the missing one.
 TEST(SceneLoader, ResourcesResolveOnlyBesideTheFile) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::path(testing::TempDir()) / "resources-beside-the-file";
+  const fs::path dir = test::scratchDir();
   fs::remove_all(dir);
   fs::create_directories(dir / "scene");
   const fs::path gltf = dir / "scene" / "scene.gltf";

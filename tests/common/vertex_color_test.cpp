@@ -19,6 +19,7 @@
 #include "common/scene.h"
 #include "common/shading.h"
 #include "common/surface.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -86,7 +87,7 @@ class GltfDoc {
     if (!data_.empty())
       d["buffers"] = {
           {{"byteLength", data_.size()}, {"uri", "data:application/octet-stream;base64," + base64(data_)}}};
-    const std::string path = ::testing::TempDir() + "/vertex_color_test_" + name + ".gltf";
+    const std::string path = test::scratchPath("vertex_color_test_" + name + ".gltf");
     std::ofstream(path) << d.dump();
     return loadScene(path);
   }
@@ -250,7 +251,7 @@ TEST(EmissiveTexture, MultipliesTheEmissiveFactor) {
 
 TEST(EmissiveTexture, LoadedWithTheBaseColourUvSet) {
   GltfDoc g;
-  writePng(::testing::TempDir() + "/vertex_color_test_1x1.png", FlatImage(1, 1));
+  writePng(test::scratchPath("vertex_color_test_1x1.png"), FlatImage(1, 1));
   g.doc()["images"] = {{{"uri", "vertex_color_test_1x1.png"}}};
   g.doc()["textures"] = {{{"source", 0}}};
   g.doc()["materials"] = {{{"emissiveFactor", {1, 1, 1}}, {"emissiveTexture", {{"index", 0}}}},
