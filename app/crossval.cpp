@@ -30,7 +30,8 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
 
   // Three deep frames are kept until they are compared: refused up front
   // when they would not fit, not after the first two.
-  checkMemory(estimateCrossvalMemory(scene, settings), settings.memory, scene.path, "",
+  const MemoryEstimate memory = estimateCrossvalMemory(scene, settings);
+  checkMemory(memory, settings.memory, scene.path, "",
               "cross-validating " + std::to_string(settings.camera.width()) + "x" +
                   std::to_string(settings.camera.height()) + " at " + std::to_string(settings.spp) +
                   " spp (three deep frames)");
@@ -38,14 +39,14 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
   s.keepSamples = true;
   s.renderer = RendererKind::Raster;
   say("raster");
-  r.raster = renderScene(scene, s);
+  r.raster = renderScene(scene, s, &memory);
   s.renderer = RendererKind::Raytrace;
   say("raytrace");
-  r.raytrace = renderScene(scene, s);
+  r.raytrace = renderScene(scene, s, &memory);
   s.renderer = RendererKind::Hybrid;
   s.raster.shadows = ShadowMode::Rays;
   say("hybrid");
-  r.hybrid = renderScene(scene, s);
+  r.hybrid = renderScene(scene, s, &memory);
   r.camera = r.raytrace.camera;
   r.analysis = r.raytrace.analysis;
 

@@ -5,6 +5,7 @@
 
 #include <tbb/info.h>
 
+#include "common/parallel.h"
 #include "raster/bin.h"
 #include "raster/setup.h"
 #include "raster/tile_renderer.h"
@@ -52,43 +53,71 @@ int threadsOf(const RenderSettings& s) {
 
 bool transparent(const Material& m) { return m.alphaMode == AlphaMode::Blend || m.isRefractive(); }
 
-// The polygon `in` clipped to the half plane a·p + c >= 0 (Sutherland–Hodgman).
-std::vector<glm::dvec3> clipPolygon(const std::vector<glm::dvec3>& in, const glm::dvec3& a, double c) {
-  std::vector<glm::dvec3> out;
-  for (size_t i = 0; i < in.size(); ++i) {
-    const glm::dvec3& p = in[i];
-    const glm::dvec3& q = in[(i + 1) % in.size()];
-    const double dp = glm::dot(a, p) + c, dq = glm::dot(a, q) + c;
-    if (dp >= 0) out.push_back(p);
-    if ((dp >= 0) != (dq >= 0)) out.push_back(p + (q - p) * (dp / (dp - dq)));
+// A convex polygon of at most 8 vertices: a triangle clipped by the near
+// plane and the image's four sides gains at most one vertex per plane.
+// Fixed-size, so the coverage pass allocates nothing per triangle.
+struct ClipPolygon {
+  glm::dvec2 v[8];
+  glm::dvec2 w[8];  // scratch for clipping
+  int n = 0;
+
+  // Keeps the half plane a·p + c >= 0 (Sutherland–Hodgman).
+  void clip(const glm::dvec2& a, double c) {
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const glm::dvec2& p = v[i];
+      const glm::dvec2& q = v[(i + 1) % n];
+      const double dp = glm::dot(a, p) + c, dq = glm::dot(a, q) + c;
+      if (dp >= 0) w[m++] = p;
+      if ((dp >= 0) != (dq >= 0)) w[m++] = p + (q - p) * (dp / (dp - dq));
+    }
+    std::copy(w, w + m, v);
+    n = m;
   }
-  return out;
-}
+  double area() const {
+    double twice = 0.0;
+    for (int i = 0; i < n; ++i) twice += v[i].x * v[(i + 1) % n].y - v[(i + 1) % n].x * v[i].y;
+    return std::abs(twice) * 0.5;
+  }
+};
 
 // Pixels a triangle covers: clipped to the near plane in view space, then
-// projected and clipped to the image rectangle.
+// projected and clipped to the image rectangle. Most triangles of a large
+// scene lie wholly inside the image or wholly off one side of it; neither
+// needs the clipper.
 double coveredPixels(const Camera& camera, const glm::dvec2& scale, const glm::dvec3 (&world)[3]) {
-  std::vector<glm::dvec3> poly;
-  for (const glm::dvec3& w : world) poly.push_back(glm::dvec3(camera.viewFromWorld * glm::dvec4(w, 1.0)));
-  poly = clipPolygon(poly, {0, 0, -1}, -camera.znear);  // z <= -znear
-  if (poly.size() < 3) return 0.0;
+  glm::dvec3 view[4];
+  int n = 0;
+  const glm::dvec3 v[3] = {glm::dvec3(camera.viewFromWorld * glm::dvec4(world[0], 1.0)),
+                           glm::dvec3(camera.viewFromWorld * glm::dvec4(world[1], 1.0)),
+                           glm::dvec3(camera.viewFromWorld * glm::dvec4(world[2], 1.0))};
+  // Near plane z <= -znear in view space (3 vertices in, at most 4 out).
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec3& p = v[i];
+    const glm::dvec3& q = v[(i + 1) % 3];
+    const double dp = -p.z - camera.znear, dq = -q.z - camera.znear;
+    if (dp >= 0) view[n++] = p;
+    if ((dp >= 0) != (dq >= 0)) view[n++] = p + (q - p) * (dp / (dp - dq));
+  }
+  if (n < 3) return 0.0;
   const bool perspective = camera.projection == Projection::Perspective;
-  for (glm::dvec3& p : poly) {
+  const double width = camera.width, height = camera.height;
+  ClipPolygon poly;
+  glm::dvec2 lo(HUGE_VAL), hi(-HUGE_VAL);
+  for (int i = 0; i < n; ++i) {
+    const glm::dvec3& p = view[i];
     const double depth = perspective ? -p.z : 1.0;
     const glm::dvec2 image = camera.imageFromNdc({p.x / (scale.x * depth), p.y / (scale.y * depth)});
-    p = glm::dvec3(image, 0.0);
+    poly.v[poly.n++] = image;
+    lo = glm::min(lo, image);
+    hi = glm::max(hi, image);
   }
-  poly = clipPolygon(poly, {1, 0, 0}, 0.0);
-  poly = clipPolygon(poly, {-1, 0, 0}, double(camera.width));
-  poly = clipPolygon(poly, {0, 1, 0}, 0.0);
-  poly = clipPolygon(poly, {0, -1, 0}, double(camera.height));
-  double twiceArea = 0.0;
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const glm::dvec3& p = poly[i];
-    const glm::dvec3& q = poly[(i + 1) % poly.size()];
-    twiceArea += p.x * q.y - q.x * p.y;
-  }
-  return std::abs(twiceArea) * 0.5;
+  if (hi.x <= 0.0 || hi.y <= 0.0 || lo.x >= width || lo.y >= height) return 0.0;
+  if (lo.x < 0.0) poly.clip({1, 0}, 0.0);
+  if (hi.x > width) poly.clip({-1, 0}, width);
+  if (lo.y < 0.0) poly.clip({0, 1}, 0.0);
+  if (hi.y > height) poly.clip({0, -1}, height);
+  return poly.area();
 }
 
 uint64_t textureTexels(const Scene& scene) {
@@ -136,28 +165,47 @@ MemoryEstimate withSlack(const RenderMemory& frame, const MemoryEstimate& extra)
 }  // namespace
 
 ProjectedCoverage projectedCoverage(const Scene& scene, const Camera& camera, bool withOpaque) {
+  // Blocks of at most kBlock triangles of one instance, summed in parallel
+  // and then added in block order: the same total whatever the threads.
+  constexpr uint32_t kBlock = 1 << 15;
+  struct Block {
+    uint32_t instance, first, count;
+  };
+  std::vector<Block> blocks;
+  for (uint32_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (!withOpaque && !transparent(scene.materials[inst.material])) continue;
+    for (uint32_t t = 0; t < inst.triangleCount; t += kBlock)
+      blocks.push_back({i, inst.firstTriangle + t, std::min(kBlock, inst.triangleCount - t)});
+  }
   const glm::dvec2 scale = camera.ndcScale();
-  double opaque = 0.0, transparentPixels = 0.0;
-  for (const Instance& inst : scene.instances) {
-    const bool isTransparent = transparent(scene.materials[inst.material]);
-    if (!isTransparent && !withOpaque) continue;
-    for (uint32_t t = 0; t < inst.triangleCount; ++t) {
-      const glm::uvec3& tri = scene.triangles[inst.firstTriangle + t];
+  std::vector<double> pixels(blocks.size());
+  parallelFor(size_t(0), blocks.size(), [&](size_t b) {
+    double sum = 0.0;
+    for (uint32_t t = blocks[b].first; t < blocks[b].first + blocks[b].count; ++t) {
+      const glm::uvec3& tri = scene.triangles[t];
       const glm::dvec3 world[3] = {glm::dvec3(scene.positions[tri.x]), glm::dvec3(scene.positions[tri.y]),
                                    glm::dvec3(scene.positions[tri.z])};
-      (isTransparent ? transparentPixels : opaque) += coveredPixels(camera, scale, world);
+      sum += coveredPixels(camera, scale, world);
     }
-  }
+    pixels[b] = sum;
+  });
+  double opaque = 0.0, transparentPixels = 0.0;
+  for (size_t b = 0; b < blocks.size(); ++b)
+    (transparent(scene.materials[scene.instances[blocks[b].instance].material]) ? transparentPixels
+                                                                                : opaque) += pixels[b];
   const double imagePixels = double(camera.width) * double(camera.height);
   return {withOpaque ? std::min(1.0, opaque / imagePixels) : 1.0, transparentPixels / imagePixels};
 }
 
+ProjectedCoverage projectedCoverage(const Scene& scene, const RenderSettings& s, bool withOpaque) {
+  return projectedCoverage(
+      scene, makeCamera(scene, s.camera.overrides(), s.camera.width(), s.camera.height()), withOpaque);
+}
+
 RenderMemory estimateFrameMemory(const Scene& scene, const RenderSettings& s, RendererKind kind,
-                                 bool keepSamples) {
+                                 bool keepSamples, const ProjectedCoverage& coverage) {
   RenderMemory m;
-  const Camera camera = makeCamera(scene, s.camera.overrides(), s.camera.width(), s.camera.height());
-  // Only deep output needs the opaque coverage (one pass over every triangle).
-  const ProjectedCoverage coverage = projectedCoverage(scene, camera, keepSamples);
   const double layers = coverage.transparentLayers;
   m.kept.add("image", mulSat(pixelsOf(s), kFlatPixelBytes));
   if (keepSamples) {
@@ -178,15 +226,19 @@ RenderMemory estimateFrameMemory(const Scene& scene, const RenderSettings& s, Re
 }
 
 MemoryEstimate estimateRenderMemory(const Scene& scene, const RenderSettings& s) {
-  return withSlack(estimateFrameMemory(scene, s, s.renderer, s.keepSamples), {});
+  // Only deep output needs the opaque coverage.
+  const ProjectedCoverage coverage = projectedCoverage(scene, s, s.keepSamples);
+  return withSlack(estimateFrameMemory(scene, s, s.renderer, s.keepSamples, coverage), {});
 }
 
 MemoryEstimate estimateCrossvalMemory(const Scene& scene, const RenderSettings& s) {
   // The three frames' outputs stay until the comparison; their transient
   // structures exist one frame at a time.
+  // One camera, one coverage pass for the three.
+  const ProjectedCoverage coverage = projectedCoverage(scene, s, true);
   RenderMemory all;
   for (RendererKind kind : {RendererKind::Raster, RendererKind::Raytrace, RendererKind::Hybrid}) {
-    const RenderMemory frame = estimateFrameMemory(scene, s, kind, true);
+    const RenderMemory frame = estimateFrameMemory(scene, s, kind, true, coverage);
     for (const auto& [part, bytes] : frame.kept.parts())
       if (part != "mip chains" || kind == RendererKind::Raster) all.kept.add(part, bytes);  // one shared set
     if (frame.transient.total() > all.transient.total()) all.transient = frame.transient;
@@ -199,7 +251,8 @@ MemoryEstimate estimateCrossvalMemory(const Scene& scene, const RenderSettings& 
 }
 
 MemoryEstimate estimateRenderCommandMemory(const Scene& scene, const RenderSettings& s, OutputFormat format) {
-  const RenderMemory frame = estimateFrameMemory(scene, s, s.renderer, s.keepSamples);
+  const RenderMemory frame =
+      estimateFrameMemory(scene, s, s.renderer, s.keepSamples, projectedCoverage(scene, s, s.keepSamples));
   MemoryEstimate writing;
   switch (format) {
     case OutputFormat::Png:

@@ -24,7 +24,11 @@ struct ProjectedCoverage {
   double opaque = 1.0;
   double transparentLayers = 0.0;
 };
+// One pass over the triangles (clipping only those that cross the near
+// plane or the image's border), parallel, the same sum at any thread count.
 ProjectedCoverage projectedCoverage(const Scene& scene, const Camera& camera, bool withOpaque);
+// The same for the camera `settings` render with.
+ProjectedCoverage projectedCoverage(const Scene& scene, const RenderSettings& settings, bool withOpaque);
 
 // One frame of `kind`: what its output keeps (image, deep samples) and
 // what exists only while it renders (setups, bins, depth target, shadow
@@ -35,7 +39,7 @@ struct RenderMemory {
   double deepEntries = 0.0;  // expected deep samples (with keepSamples)
 };
 RenderMemory estimateFrameMemory(const Scene& scene, const RenderSettings& settings, RendererKind kind,
-                                 bool keepSamples);
+                                 bool keepSamples, const ProjectedCoverage& coverage);
 
 // The peak of renderScene(scene, settings): resident now + kept + transient.
 MemoryEstimate estimateRenderMemory(const Scene& scene, const RenderSettings& settings);

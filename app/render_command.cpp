@@ -65,8 +65,8 @@ int runRender(RenderCommandOptions& opt) {
                                                                            : OutputFormat::Exr);
   checkMemory(memory, settings.memory, scene.path, "",
               describeRenderWork(settings, toString(settings.renderer)));
-  RenderRun run = renderScene(scene, settings);
-  run.memoryEstimate = memory;  // what --json and --stats report: the command's whole estimate
+  // What --json and --stats report: the command's whole estimate.
+  RenderRun run = renderScene(scene, settings, &memory);
   // The last check: a write that has begun finishes (and renames its
   // temporary file into place) even if a signal arrives during it.
   throwIfInterrupted();

@@ -434,7 +434,7 @@ RenderOutput FrameRenderer::frame() {
   return {};
 }
 
-RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
+RenderRun renderScene(const Scene& scene, const RenderSettings& s, const MemoryEstimate* checked) {
   RasterOptions raster = s.raster;
   RayOptions ray = s.ray;
   raster.keepSamples = ray.keepSamples = s.keepSamples;
@@ -448,8 +448,8 @@ RenderRun renderScene(const Scene& scene, const RenderSettings& s) {
   if (s.debugPixel && !raster.trace.sink) raster.trace = {&rasterTrace, *s.debugPixel};
   TraceLog rayTrace;  // the ray caster's ray tree, likewise (--renderer raytrace)
   if (s.debugPixel && !ray.trace.sink) ray.trace = {&rayTrace, *s.debugPixel};
-  const MemoryEstimate memory = estimateRenderMemory(scene, s);
-  checkMemory(memory, s.memory, scene.path, "", describeRenderWork(s, toString(s.renderer)));
+  const MemoryEstimate memory = checked ? *checked : estimateRenderMemory(scene, s);
+  if (!checked) checkMemory(memory, s.memory, scene.path, "", describeRenderWork(s, toString(s.renderer)));
 
   const auto start = std::chrono::steady_clock::now();
   FrameRenderer renderer(scene, s, raster, ray);

@@ -168,11 +168,14 @@ Scene loadSceneForRender(const std::string& path, const RenderSettings& settings
 
 // Runs the chosen renderer; settings.finish() must have been called.
 // Refuses (InputError, exit 2) before allocating when the estimated peak
-// memory (app/memory_estimate.h) exceeds settings.memory.
+// memory (app/memory_estimate.h) exceeds settings.memory, unless the
+// caller passes `checked`: an estimate covering this render that it has
+// checked already (render -o, crossval), which the run then reports.
 // With settings.debugPixel, what the renderer recorded at that pixel is
 // printed to stderr afterwards, unless the caller gave the renderer's
 // options a trace sink of its own (explain).
-RenderRun renderScene(const Scene& scene, const RenderSettings& settings);
+RenderRun renderScene(const Scene& scene, const RenderSettings& settings,
+                      const MemoryEstimate* checked = nullptr);
 
 // The ray caster's events of one pixel (TraceStage::Ray) as text under a
 // "ray tree of pixel (x, y): N rays" line; empty without ray events.
