@@ -245,15 +245,15 @@ int runSweep(const SweepOptions& opt) {
   return 0;
 }
 
-// `rastray sweep --crossover [--report DIR] [--quick] [--threads N]`: the
+// `rastray sweep --crossover [--report DIR] [--quick] [--threads N] [--resume]`: the
 // study renders its own generated scenes, so it takes no scene, --vary or
 // other render option.
 int runCrossoverStudy(const SweepOptions& opt) {
-  if (!opt.scenes.empty() || !opt.vary.empty() || !opt.merge.empty() || !opt.shard.empty() || opt.resume ||
+  if (!opt.scenes.empty() || !opt.vary.empty() || !opt.merge.empty() || !opt.shard.empty() ||
       opt.cmd->get_option("--reference")->count() || opt.cmd->get_option("--repeat")->count())
     throw InputError("command line", "--crossover",
-                     "renders its own generated scenes: no SCENE, --vary, --reference, --repeat, --shard, "
-                     "--resume or --merge");
+                     "renders its own generated scenes: no SCENE, --vary, --reference, --repeat, --shard "
+                     "or --merge");
   for (const std::string& arg : plainRenderArgs(opt))
     if (arg.rfind("--", 0) == 0 && arg != "--threads")
       throw InputError("command line", "--crossover",
@@ -262,6 +262,7 @@ int runCrossoverStudy(const SweepOptions& opt) {
   o.reportDir = opt.reportDir;
   o.quick = opt.quick;
   o.threads = opt.settings.threads;
+  o.resume = opt.resume;
   return crossover::runCrossover(o);
 }
 
@@ -289,7 +290,8 @@ CommandRunner addSweepCommand(CLI::App& app) {
       "--report", opt->reportDir,
       "Folder for sweep.csv, sweep.json, index.html and plots/ (--crossover: default crossover-report)");
   cmd->add_option("--shard", opt->shard, "K/N: run only the cells whose number is K modulo N");
-  cmd->add_flag("--resume", opt->resume, "Skip the cells already in the report folder's sweep.csv");
+  cmd->add_flag("--resume", opt->resume,
+                "Skip the cells already in the report folder's sweep.csv (--crossover: crossover.json)");
   cmd->add_option("--merge", opt->merge, "Shard report folders to join into --report (no scenes)");
   cmd->add_flag(
       "--crossover", opt->crossover,

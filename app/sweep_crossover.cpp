@@ -16,6 +16,7 @@
 #include "app/sweep_crossover_scene.h"
 #include "common/error.h"
 #include "common/image.h"
+#include "common/interrupt.h"
 
 namespace rastray::crossover {
 
@@ -505,8 +506,8 @@ std::string formatTable(const std::vector<CellResult>& rows) {
   return out;
 }
 
-std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta& meta,
-                                     const std::function<void(const CellResult&, size_t, size_t)>& onCell) {
+StudyMeta studyMeta(const CrossoverOptions& options) {
+  StudyMeta meta;
   meta.quick = options.quick;
   meta.triangles = options.triangles.empty() ? defaultTriangles(options.quick) : options.triangles;
   meta.sizes = options.sizes.empty() ? defaultSizes(options.quick) : options.sizes;
@@ -520,6 +521,13 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
   for (const ImageSize& s : meta.sizes)
     if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
       throw InputError("command line", "--crossover", "image sizes must be 1 to 16384 pixels a side");
+  return meta;
+}
+
+std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta& meta,
+                                     const std::function<void(const CellResult&, size_t, size_t)>& onCell,
+                                     const std::vector<CellResult>& finished) {
+  meta = studyMeta(options);
   const std::string rastray = options.rastray.empty() ? selfExecutable() : options.rastray;
   ChildLimits limits;
   limits.timeoutSeconds = options.cellTimeoutSeconds;
@@ -531,6 +539,8 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
 
   meta.loadStart = loadAverage();
   const auto start = std::chrono::steady_clock::now();
+  // The generated meshes and the children's output live here; removed on
+  // return and when an interruption unwinds.
   ScratchDir scratch;
   std::vector<CellResult> rows;
   const size_t total = meta.triangles.size() * meta.sizes.size() * 2;
@@ -538,39 +548,45 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
   // as many triangles and pixels as one of them is skipped.
   std::vector<std::pair<uint64_t, uint64_t>> failed[2];
   for (const uint64_t t : meta.triangles) {
+    // The two variants of this count for one aspect ratio, written when a
+    // cell first needs them and kept for the sizes that share it (the sizes
+    // are in order); the meshes are freed before any child runs.
     std::string lit, unlit;
     double aspect = 0;
     for (const ImageSize& s : meta.sizes)
       for (int k = 0; k < 2; ++k) {
-        // The two variants of this count for this size's aspect ratio, written
-        // once for the sizes that share it (the sizes are in order); the
-        // meshes are freed before any child runs.
-        const double sizeAspect = double(s.width) / double(s.height);
-        if (sizeAspect != aspect) {
-          if (!lit.empty()) {
-            std::filesystem::remove(lit);
-            std::filesystem::remove(unlit);
-          }
-          aspect = sizeAspect;
-          const std::string name = std::to_string(t) + "-" + sizeText(s.width, s.height) + ".glb";
-          lit = scratch.path + "/lit-" + name;
-          unlit = scratch.path + "/unlit-" + name;
-          crossoverScene(t, true, aspect).writeGlb(lit);
-          crossoverScene(t, false, aspect).writeGlb(unlit);
-        }
+        throwIfInterrupted();
         CellResult r;
         r.triangles = t;
         r.width = s.width;
         r.height = s.height;
         r.renderer = kRenderers[k];
         const uint64_t pixels = uint64_t(s.width) * uint64_t(s.height);
+        const auto earlier = std::find_if(finished.begin(), finished.end(), [&](const CellResult& f) {
+          return f.triangles == t && f.width == s.width && f.height == s.height && f.renderer == r.renderer;
+        });
+        if (earlier != finished.end()) r = *earlier;  // measured by the run being resumed
         for (const auto& [ft, fp] : failed[k])
-          if (t >= ft && pixels >= fp) {
+          if (r.status.empty() && t >= ft && pixels >= fp) {
             r.status = "skipped";
             r.detail = "a smaller cell of this renderer (" + countText(ft) + " triangles, " +
                        std::to_string(fp) + " pixels) did not run";
           }
         if (r.status.empty()) {
+          const double sizeAspect = double(s.width) / double(s.height);
+          if (sizeAspect != aspect) {
+            if (!lit.empty()) {
+              std::filesystem::remove(lit);
+              std::filesystem::remove(unlit);
+            }
+            aspect = sizeAspect;
+            const std::string name = std::to_string(t) + "-" + sizeText(s.width, s.height) + ".glb";
+            lit = scratch.path + "/lit-" + name;
+            unlit = scratch.path + "/unlit-" + name;
+            crossoverScene(t, true, aspect).writeGlb(lit);
+            crossoverScene(t, false, aspect).writeGlb(unlit);
+            throwIfInterrupted();
+          }
           const Variant vis =
               measureVariant(rastray, unlit, r.renderer, s, meta.threads, maxRuns, scratch.path, limits);
           r.visibilityPeakRssBytes = vis.summary.peakRss;
@@ -591,10 +607,10 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
               r.processSeconds = shaded.summary.wall;
             }
           }
-          // Only a cell that ran out of a resource says the larger ones will too.
-          if (r.status == "out of memory" || r.status == "killed" || r.status == "timeout")
-            failed[k].push_back({t, pixels});
         }
+        // Only a cell that ran out of a resource says the larger ones will too.
+        if (r.status == "out of memory" || r.status == "killed" || r.status == "timeout")
+          failed[k].push_back({t, pixels});
         rows.push_back(r);
         if (onCell) onCell(r, rows.size(), total);
       }
@@ -608,13 +624,18 @@ std::vector<CellResult> measureCells(const CrossoverOptions& options, StudyMeta&
   return rows;
 }
 
-void writeCrossoverReport(const std::string& dir, const StudyMeta& meta,
+void writeCrossoverTables(const std::string& dir, const StudyMeta& meta,
                           const std::vector<CellResult>& rows) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError(dir, "", "cannot create the report folder: " + ec.message());
   writeTextFile(dir + "/crossover.csv", toCsv(rows));
   writeTextFile(dir + "/crossover.json", toJson(meta, rows).dump(2) + "\n");
+}
+
+void writeCrossoverReport(const std::string& dir, const StudyMeta& meta,
+                          const std::vector<CellResult>& rows) {
+  writeCrossoverTables(dir, meta, rows);
   std::string body = "<h1>Rasterizer against ray caster: where each wins</h1>\n";
   body +=
       "<p>Generated terrain meshes of " + countText(meta.triangles.front()) + " to " +
@@ -662,19 +683,63 @@ void writeCrossoverReport(const std::string& dir, const StudyMeta& meta,
 
 int runCrossover(const CrossoverOptions& options) {
   const bool terminal = options.progress && ::isatty(2);
+  const std::string dir = options.reportDir.empty() ? "crossover-report" : options.reportDir;
+  const std::string json = dir + "/crossover.json";
+  // --resume: the rows of an earlier run of the same study in DIR are kept.
+  StudyMeta earlierMeta;
+  std::vector<CellResult> earlier;
+  if (options.resume && std::filesystem::exists(json)) {
+    readJson(json, earlierMeta, earlier);
+    const StudyMeta now = studyMeta(options);
+    const auto same = [](const std::vector<ImageSize>& a, const std::vector<ImageSize>& b) {
+      return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const ImageSize& x, const ImageSize& y) {
+        return x.width == y.width && x.height == y.height;
+      });
+    };
+    if (earlierMeta.triangles != now.triangles || !same(earlierMeta.sizes, now.sizes) ||
+        earlierMeta.threads != now.threads || earlierMeta.quick != now.quick)
+      throw InputError(json, "triangles",
+                       "holds another crossover study (other triangle counts, sizes, --threads or --quick): "
+                       "resume needs the same study");
+    std::fprintf(stderr, "resume: %zu cells already in %s\n", earlier.size(), json.c_str());
+  }
+  // Ctrl-C (common/interrupt.h): the cell in progress is dropped (its child
+  // is stopped, the generated meshes are removed); the finished cells are
+  // in crossover.csv and crossover.json, written after each, for --resume.
+  installInterruptHandlers();
   const auto start = std::chrono::steady_clock::now();
   StudyMeta meta;
-  const std::vector<CellResult> rows =
-      measureCells(options, meta, [&](const CellResult& r, size_t done, size_t total) {
-        if (!terminal) return;
-        const double elapsed =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        std::fprintf(stderr, "\rcrossover: %zu/%zu cells, %.0f s (%s triangles, %s, %s: %s)\033[K", done,
-                     total, elapsed, countText(r.triangles).c_str(), sizeText(r.width, r.height).c_str(),
-                     r.renderer.c_str(), r.status.c_str());
-        if (done == total) std::fprintf(stderr, "\n");
-      });
-  const std::string dir = options.reportDir.empty() ? "crossover-report" : options.reportDir;
+  std::vector<CellResult> rows;
+  const auto onCell = [&](const CellResult& r, size_t done, size_t cells) {
+    rows.push_back(r);
+    meta.seconds =
+        earlierMeta.seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    writeCrossoverTables(dir, meta, rows);
+    if (!terminal) return;
+    std::fprintf(stderr, "\rcrossover: %zu/%zu cells, %.0f s (%s triangles, %s, %s: %s)\033[K", done, cells,
+                 meta.seconds, countText(r.triangles).c_str(), sizeText(r.width, r.height).c_str(),
+                 r.renderer.c_str(), r.status.c_str());
+    if (done == cells) std::fprintf(stderr, "\n");
+  };
+  try {
+    measureCells(options, meta, onCell, earlier);
+  } catch (const Interrupted& e) {
+    if (terminal) std::fprintf(stderr, "\r\033[K");
+    const StudyMeta study = studyMeta(options);
+    const size_t cells = study.triangles.size() * study.sizes.size() * 2;
+    std::string account = std::to_string(rows.size()) + " of " + std::to_string(cells) + " cells finished";
+    if (!rows.empty()) account += " (in " + json + "; --resume runs the rest)";
+    // Cells run in order: triangle count, then size, then renderer.
+    const size_t next = rows.size();
+    if (next < cells) {
+      const uint64_t t = study.triangles[next / (study.sizes.size() * 2)];
+      const ImageSize& s = study.sizes[next / 2 % study.sizes.size()];
+      account += "; the cell of " + countText(t) + " triangles at " + sizeText(s.width, s.height) + " (" +
+                 kRenderers[next % 2] + ") not finished";
+    }
+    throw e.withFinished(account);
+  }
+  meta.seconds += earlierMeta.seconds;
   writeCrossoverReport(dir, meta, rows);
   std::printf("%s", formatTable(rows).c_str());
   std::printf("\nwhere each renderer is faster (shaded frame; slower/faster time):\n");

@@ -61,6 +61,9 @@ struct CrossoverOptions {
   // of address space).
   uint64_t childMemoryLimitBytes = 0;
   bool progress = true;  // cells done and elapsed time to stderr when it is a terminal
+  // Keep the cells an earlier, interrupted run of the same study left in
+  // reportDir/crossover.json and measure only the rest.
+  bool resume = false;
 };
 
 // 1e2, 1e3, ..., 1e7 (quick: to 1e5).
@@ -144,17 +147,30 @@ std::vector<NamedPlot> crossoverPlots(const StudyMeta& meta, const std::vector<C
 // The table printed for a person: one line per triangle count and size.
 std::string formatTable(const std::vector<CellResult>& rows);
 
-// Measures every cell; `onCell` (may be empty) sees each row as it is done.
+// What the options ask for: triangle counts, sizes, threads, the machine
+// (InputError on counts or sizes out of range).
+StudyMeta studyMeta(const CrossoverOptions& options);
+
+// Measures every cell, in order (triangle count, size, renderer); `onCell`
+// (may be empty) sees each row as it is done. A cell found in `finished`
+// (same count, size and renderer) is taken from there, not measured. On a
+// stop request (common/interrupt.h) the running child is stopped, the
+// generated meshes are removed and Interrupted is thrown.
 std::vector<CellResult> measureCells(
     const CrossoverOptions& options, StudyMeta& meta,
-    const std::function<void(const CellResult&, size_t done, size_t total)>& onCell);
+    const std::function<void(const CellResult&, size_t done, size_t total)>& onCell,
+    const std::vector<CellResult>& finished = {});
 
-// Writes DIR/crossover.csv, DIR/crossover.json, DIR/crossover-*.svg and
-// DIR/index.html (each atomically).
+// Writes DIR/crossover.csv and DIR/crossover.json (each atomically).
+void writeCrossoverTables(const std::string& dir, const StudyMeta& meta, const std::vector<CellResult>& rows);
+// The tables, DIR/crossover-*.svg and DIR/index.html (each atomically).
 void writeCrossoverReport(const std::string& dir, const StudyMeta& meta, const std::vector<CellResult>& rows);
 
-// The whole study: measures, prints the table, writes the report. Exit
-// status 0 when every cell ran or was recorded; 2 on bad options.
+// The whole study: measures, prints the table, writes the report; the
+// tables are written after every cell as well, so an interrupted study
+// (exit 130/143, saying which cells finished) can be resumed. Exit status
+// 0 when every cell ran or was recorded; 2 on bad options or a report
+// folder holding another study (with resume).
 int runCrossover(const CrossoverOptions& options);
 
 }  // namespace rastray::crossover

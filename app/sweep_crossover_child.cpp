@@ -16,6 +16,8 @@
 #include <sstream>
 #include <thread>
 
+#include "common/interrupt.h"
+
 namespace rastray::crossover {
 
 namespace {
@@ -95,8 +97,13 @@ ChildResult runChild(const std::string& program, const std::vector<std::string>&
   // Poll with wait4 so the child's own rusage comes back with its status; a
   // 2 ms poll adds at most that to the wall time (the study's times come
   // from the child's own clock, not this one).
+  // A stop request (common/interrupt.h) is passed on as SIGTERM: a child
+  // in the terminal's process group has had the Ctrl-C itself, one started
+  // by a parent that alone was sent SIGTERM has not. It gets 5 s to stop
+  // (rastray stops within a tile), then SIGKILL.
   int status = 0;
   rusage usage{};
+  double stopSentAt = -1;
   for (;;) {
     const pid_t done = ::wait4(pid, &status, WNOHANG, &usage);
     if (done == pid) break;
@@ -106,8 +113,15 @@ ChildResult runChild(const std::string& program, const std::vector<std::string>&
       r.timedOut = true;
       ::kill(pid, SIGKILL);
     }
+    if (interruptRequested() && stopSentAt < 0) {
+      stopSentAt = elapsed;
+      ::kill(pid, SIGTERM);
+    }
+    if (stopSentAt >= 0 && elapsed > stopSentAt + 5.0) ::kill(pid, SIGKILL);
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
+  // The child is gone: the caller's stop comes before anything it said.
+  if (stopSentAt >= 0) throwIfInterrupted();
   r.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.peakRssBytes = uint64_t(usage.ru_maxrss) * 1024;  // Linux: KiB
   if (WIFEXITED(status)) r.exitCode = WEXITSTATUS(status);

@@ -28,7 +28,9 @@ struct ChildResult {
 };
 
 // Runs `program` with `args` (argv[1..]); stdin is /dev/null, stdout and
-// stderr go to files in `scratchDir` and are read back.
+// stderr go to files in `scratchDir` and are read back. When a stop is
+// requested while it runs (common/interrupt.h), the child is sent SIGTERM
+// (SIGKILL 5 s later) and, once it has exited, Interrupted is thrown.
 ChildResult runChild(const std::string& program, const std::vector<std::string>& args,
                      const std::string& scratchDir, const ChildLimits& limits);
 

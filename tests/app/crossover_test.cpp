@@ -9,16 +9,22 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/render_setup.h"
 #include "app/sweep_crossover_scene.h"
 #include "common/error.h"
+#include "common/interrupt.h"
 #include "common/scene.h"
 #include "run_command.h"
 #include "tests/test_files.h"
@@ -281,6 +287,72 @@ TEST(Crossover, CommandRefusesWhatDoesNotApply) {
     EXPECT_EQ(r.status, 2) << args.back();
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
+}
+
+// Ctrl-C or SIGTERM during the study (issue 13): the child rendering the
+// cell in progress is stopped, the generated meshes are removed, the cells
+// finished so far stay in crossover.csv and crossover.json (written after
+// each), the account names the cell not finished; --resume keeps those
+// cells as measured and runs the rest.
+TEST(Crossover, InterruptedStudyKeepsFinishedCellsAndResumes) {
+  const fs::path dir = test::scratchDir();
+  const fs::path temp = dir / "temp";  // where the study's scratch folder goes
+  fs::create_directories(temp);
+  const char* oldTmp = std::getenv("TMPDIR");
+  const std::string savedTmp = oldTmp ? oldTmp : "";
+  ::setenv("TMPDIR", temp.c_str(), 1);
+  CrossoverOptions options = tinyStudy((dir / "report").string());
+  const fs::path json = dir / "report" / "crossover.json";
+  auto rowsIn = [&](const fs::path& file) {
+    std::error_code ec;
+    if (!fs::exists(file, ec)) return size_t(0);
+    return nlohmann::json::parse(slurp(file)).at("rows").size();
+  };
+  // The stop arrives once the first cell is on disk, while the second runs.
+  std::atomic<bool> done{false};
+  std::thread stopper([&] {
+    while (!done && rowsIn(json) < 1) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (!done) setInterruptForTesting(SIGTERM);
+  });
+  std::string account;
+  try {
+    runCrossover(options);
+  } catch (const Interrupted& e) {
+    account = e.finished();
+  }
+  done = true;
+  stopper.join();
+  setInterruptForTesting(0);
+  ASSERT_FALSE(account.empty()) << "the study finished before the stop arrived";
+  const size_t finished = rowsIn(json);
+  EXPECT_GE(finished, 1u);
+  EXPECT_NE(account.find(std::to_string(finished) + " of 8 cells finished (in " + json.string() +
+                         "; --resume runs the rest); the cell of "),
+            std::string::npos)
+      << account;
+  EXPECT_NE(account.find(") not finished"), std::string::npos) << account;
+  EXPECT_TRUE(fs::is_empty(temp)) << "generated meshes left in " << temp;
+  EXPECT_FALSE(fs::exists(dir / "report" / "index.html"));  // the full report is written at the end
+  const std::string csvBefore = slurp(dir / "report" / "crossover.csv");
+
+  options.resume = true;
+  options.progress = false;
+  EXPECT_EQ(runCrossover(options), 0);
+  if (oldTmp)
+    ::setenv("TMPDIR", savedTmp.c_str(), 1);
+  else
+    ::unsetenv("TMPDIR");
+  EXPECT_EQ(rowsIn(json), 8u);
+  // The finished cells are kept as they were measured: the earlier CSV is
+  // the start of the new one.
+  const std::string csvAfter = slurp(dir / "report" / "crossover.csv");
+  EXPECT_EQ(csvAfter.compare(0, csvBefore.size(), csvBefore), 0) << csvBefore << "\n---\n" << csvAfter;
+  EXPECT_TRUE(fs::exists(dir / "report" / "index.html"));
+  EXPECT_TRUE(fs::is_empty(temp));
+
+  // Another study in the same folder is refused.
+  options.triangles = {100};
+  EXPECT_THROW(runCrossover(options), InputError);
 }
 
 }  // namespace
