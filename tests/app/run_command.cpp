@@ -12,16 +12,10 @@
 #include <sstream>
 #include <thread>
 
+#include "tests/test_files.h"
+
 namespace rastray::test {
 
-namespace {
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-}  // namespace
 
 CommandResult runRastrayAndSignal(const std::vector<std::string>& args, int signal,
                                   const std::function<bool(pid_t)>& ready, bool* signalled) {
