@@ -5,12 +5,12 @@
 // off (--origin world, --ray-offset float-ulps), and measured against the
 // same scene at the origin.
 //
-// Scene (local units; the offset adds to every coordinate): a 12 × 12
-// floor at y = 0; a 1.5 box and a sphere of radius 1.5 (24 × 12 facets,
-// flat normals: no NORMAL attribute) both floating 0.01 above the floor,
-// so their contact shadows are a 0.01 gap a ray offset must not jump; a
-// mirror (metallic 1, roughness 0) behind them; one directional light. The
-// camera looks down at them from (0, 4, 8).
+// Scene (app/stability_far_scene.h; local units, the offset adds to every
+// coordinate): a 12 × 12 floor at y = 0; a 1.5 box and a sphere of radius
+// 1.5 (24 × 12 facets, flat normals: no NORMAL attribute) both floating
+// 0.01 above the floor, so their contact shadows are a 0.01 gap a ray
+// offset must not jump; a mirror (metallic 1, roughness 0) behind them;
+// one directional light. The camera looks down at them from (0, 4, 8).
 //
 // Per row:
 // - visibility agreement and genuine mismatches against the origin render
@@ -30,8 +30,8 @@
 #include <unistd.h>
 
 #include "app/stability.h"
+#include "app/stability_far_scene.h"
 #include "app/stability_measure.h"
-#include "common/math_constants.h"
 
 namespace rastray::stability {
 
@@ -43,89 +43,8 @@ constexpr double kLift = 0.01;             // occluders float this far above the
 constexpr double kShadowTolerance = 1e-3;  // world units, about 1/16 pixel here (checkShadows)
 constexpr double kOffThreshold = 0.1;      // colour difference that makes a pixel "off"
 
-void addQuad(GltfMesh& m, const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2,
-             const glm::dvec3& p3, const glm::dvec3& offset, bool baked) {
-  const uint32_t base = uint32_t(m.positions.size());
-  for (const glm::dvec3& p : {p0, p1, p2, p3}) m.positions.push_back(glm::vec3(baked ? p + offset : p));
-  for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
-}
-
-GltfMesh meshAt(const glm::dvec3& offset, bool baked, int material) {
-  GltfMesh m;
-  m.material = material;
-  if (!baked) m.translation = offset;
-  return m;
-}
-
-GltfMesh box(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec3& offset, bool baked, int material) {
-  GltfMesh m = meshAt(offset, baked, material);
-  const auto c = [&](int x, int y, int z) {
-    return glm::dvec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z);
-  };
-  // Each face counter-clockwise seen from outside.
-  addQuad(m, c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1), offset, baked);  // +z
-  addQuad(m, c(1, 0, 0), c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), offset, baked);  // -z
-  addQuad(m, c(1, 0, 1), c(1, 0, 0), c(1, 1, 0), c(1, 1, 1), offset, baked);  // +x
-  addQuad(m, c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0), offset, baked);  // -x
-  addQuad(m, c(0, 1, 1), c(1, 1, 1), c(1, 1, 0), c(0, 1, 0), offset, baked);  // +y
-  addQuad(m, c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1), offset, baked);  // -y
-  return m;
-}
-
-GltfMesh sphere(const glm::dvec3& centre, double radius, const glm::dvec3& offset, bool baked, int material) {
-  GltfMesh m = meshAt(offset, baked, material);
-  constexpr int kSegments = 24, kRings = 12;
-  for (int i = 0; i <= kRings; ++i)
-    for (int j = 0; j <= kSegments; ++j) {
-      const double theta = kPi * i / kRings, phi = 2.0 * kPi * j / kSegments;
-      const glm::dvec3 p = centre + radius * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                                        -std::sin(theta) * std::sin(phi));
-      m.positions.push_back(glm::vec3(baked ? p + offset : p));
-    }
-  const auto at = [](int i, int j) { return uint32_t(i * (kSegments + 1) + j); };
-  for (int i = 0; i < kRings; ++i)
-    for (int j = 0; j < kSegments; ++j) {
-      // Counter-clockwise seen from outside; the pole rows have one triangle.
-      if (i > 0) m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i, j + 1)});
-      if (i + 1 < kRings) m.indices.insert(m.indices.end(), {at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
-    }
-  return m;
-}
-
-GltfScene farScene(double offsetValue, bool baked) {
-  const glm::dvec3 offset(offsetValue);
-  GltfScene s;
-  GltfMaterial floor, boxMaterial, sphereMaterial, mirror;
-  floor.baseColor = {0.8f, 0.8f, 0.8f, 1.0f};
-  boxMaterial.baseColor = {0.8f, 0.3f, 0.2f, 1.0f};
-  sphereMaterial.baseColor = {0.3f, 0.5f, 0.9f, 1.0f};
-  mirror.baseColor = {0.9f, 0.9f, 0.9f, 1.0f};
-  mirror.metallic = 1.0f;
-  mirror.roughness = 0.0f;
-  s.materials = {floor, boxMaterial, sphereMaterial, mirror};
-
-  GltfMesh floorMesh = meshAt(offset, baked, 0);
-  addQuad(floorMesh, {-6, 0, 6}, {6, 0, 6}, {6, 0, -6}, {-6, 0, -6}, offset, baked);
-  s.meshes.push_back(floorMesh);
-  s.meshes.push_back(box({-3.0, kLift, -0.75}, {-1.5, 1.5 + kLift, 0.75}, offset, baked, 1));
-  s.meshes.push_back(sphere({1.5, 1.5 + kLift, 0.0}, 1.5, offset, baked, 2));
-  GltfMesh mirrorMesh = meshAt(offset, baked, 3);
-  addQuad(mirrorMesh, {-4, 0.2, -3}, {4, 0.2, -3}, {4, 3.5, -3}, {-4, 3.5, -3}, offset, baked);
-  s.meshes.push_back(mirrorMesh);
-
-  GltfCamera camera;
-  camera.eye = offset + glm::dvec3(0.0, 4.0, 8.0);
-  camera.target = offset + glm::dvec3(0.0, 0.8, 0.0);
-  camera.yfov = 0.8;
-  camera.znear = 0.1;
-  camera.zfar = 100.0;
-  s.camera = camera;
-  GltfLight light;
-  light.direction = glm::normalize(glm::dvec3(-0.5, -1.0, -0.3));
-  light.intensity = 3.0f;
-  s.lights = {light};
-  return s;
-}
+// The study's scene: box and sphere kLift above the floor, mirror behind.
+GltfScene caseScene(double offset, bool baked) { return farScene({glm::dvec3(offset), baked, kLift, true}); }
 
 // The origin scene, written for the run beside nothing the user owns: a
 // temporary file removed when the run ends.
@@ -136,7 +55,7 @@ class OriginScene {
     path_ = (std::filesystem::temp_directory_path() /
              ("rastray-far-origin-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + ".gltf"))
                 .string();
-    farScene(0.0, false).write(path_);
+    caseScene(0.0, false).write(path_);
   }
   ~OriginScene() {
     std::error_code ec;
@@ -255,7 +174,7 @@ void appendFarCases(std::vector<Case>& cases) {
           (baked ? "baked into float32 vertex data" : "in node translations (local data exact)") +
           "; 480x320 (quick 240x160), 1 spp; each renderer, mitigations on and off, vs the origin scene";
       c.quick = e == 6;
-      c.build = [offset, baked] { return farScene(offset, baked); };
+      c.build = [offset, baked] { return caseScene(offset, baked); };
       const std::string name = c.name;
       c.run = [name, offset, baked](const CaseContext& ctx, const std::string& path) {
         return runFar(ctx, name, path, offset, baked);

@@ -29,6 +29,7 @@
 #include <unistd.h>
 
 #include "app/render_setup.h"
+#include "app/stability_far_scene.h"
 #include "app/stability_measure.h"
 #include "common/gltf/writer.h"
 #include "common/math_constants.h"
@@ -287,76 +288,16 @@ TEST(FarFromOriginOffsets, HybridAgreesWithTheRayCaster) {
 
 // --- the lit scene -----------------------------------------------------------
 
-// Floor 12 × 12 at y = 0, a 1.5 box and a sphere of radius 1.5 (24 × 12
-// facets, flat normals) standing on it, one directional light, camera at
-// (0, 4, 8): all moved by `offset`, baked into the float32 vertex data.
+// The stability study's far scene (app/stability_far_scene.h) with the
+// box and the sphere standing on the floor and no mirror: all moved by
+// `offset`, baked into the float32 vertex data.
 GltfScene litScene(const glm::dvec3& offset) {
-  GltfScene s;
-  GltfMaterial floor, box, ball;
-  floor.baseColor = {0.8f, 0.8f, 0.8f, 1.0f};
-  box.baseColor = {0.8f, 0.3f, 0.2f, 1.0f};
-  ball.baseColor = {0.3f, 0.5f, 0.9f, 1.0f};
-  s.materials = {floor, box, ball};
-  GltfMesh f;
-  f.material = 0;
-  addQuad(f, offset + glm::dvec3(-6, 0, 6), offset + glm::dvec3(6, 0, 6), offset + glm::dvec3(6, 0, -6),
-          offset + glm::dvec3(-6, 0, -6));
-  s.meshes.push_back(f);
-  GltfMesh b;
-  b.material = 1;
-  const glm::dvec3 lo(-3.0, 0.0, -0.75), hi(-1.5, 1.5, 0.75);
-  const auto c = [&](int x, int y, int z) {
-    return offset + glm::dvec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z);
-  };
-  addQuad(b, c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1));
-  addQuad(b, c(1, 0, 0), c(0, 0, 0), c(0, 1, 0), c(1, 1, 0));
-  addQuad(b, c(1, 0, 1), c(1, 0, 0), c(1, 1, 0), c(1, 1, 1));
-  addQuad(b, c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0));
-  addQuad(b, c(0, 1, 1), c(1, 1, 1), c(1, 1, 0), c(0, 1, 0));
-  addQuad(b, c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1));
-  s.meshes.push_back(b);
-  GltfMesh sphere;
-  sphere.material = 2;
-  constexpr int kSegments = 24, kRings = 12;
-  const glm::dvec3 centre = offset + glm::dvec3(1.5, 1.5, 0.0);
-  for (int i = 0; i <= kRings; ++i)
-    for (int j = 0; j <= kSegments; ++j) {
-      const double theta = kPi * i / kRings, phi = 2.0 * kPi * j / kSegments;
-      sphere.positions.push_back(
-          glm::vec3(centre + 1.5 * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                              -std::sin(theta) * std::sin(phi))));
-    }
-  const auto at = [](int i, int j) { return uint32_t(i * (kSegments + 1) + j); };
-  for (int i = 0; i < kRings; ++i)
-    for (int j = 0; j < kSegments; ++j) {
-      if (i > 0) sphere.indices.insert(sphere.indices.end(), {at(i, j), at(i + 1, j), at(i, j + 1)});
-      if (i + 1 < kRings)
-        sphere.indices.insert(sphere.indices.end(), {at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
-    }
-  s.meshes.push_back(sphere);
-  GltfCamera camera;
-  camera.eye = offset + glm::dvec3(0.0, 4.0, 8.0);
-  camera.target = offset + glm::dvec3(0.0, 0.8, 0.0);
-  camera.yfov = 0.8;
-  camera.znear = 0.1;
-  camera.zfar = 100.0;
-  s.camera = camera;
-  GltfLight light;
-  light.direction = glm::normalize(glm::dvec3(-0.5, -1.0, -0.3));
-  light.intensity = 3.0f;
-  s.lights = {light};
-  return s;
+  return stability::farScene({offset, /*baked=*/true, /*lift=*/0.0, /*mirror=*/false});
 }
 
-// Pixels whose colour differs by more than 0.1 in some channel.
-double fractionOff(const FlatImage& a, const FlatImage& b) {
-  size_t off = 0;
-  for (size_t i = 0; i < a.color.size(); ++i) {
-    const glm::vec4 d = glm::abs(a.color[i] - b.color[i]);
-    off += std::max({d.r, d.g, d.b, d.a}) > 0.1f;
-  }
-  return double(off) / double(a.color.size());
-}
+// Pixels whose colour differs by more than 0.1f in some channel (a NaN
+// counts as different).
+double fractionOff(const FlatImage& a, const FlatImage& b) { return stability::fractionOff(a, b, 0.1f); }
 
 // The table row "baked into float32 vertex data, 1e6", for the ray
 // caster. The offset moves every coordinate, the case, and x, z
