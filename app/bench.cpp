@@ -10,7 +10,7 @@
 
 #include <tbb/global_control.h>
 
-#include "app/sweep_table.h"
+#include "app/csv.h"
 #include "common/memory_budget.h"
 
 namespace rastray {
@@ -149,7 +149,7 @@ std::string benchCsvHeader() {
 
 std::string benchCsvRow(const BenchResult& r) {
   char row[4096];  // the scene path is the only field of unbounded length
-  const std::string scene = sweep::csvQuote(r.scenePath);
+  const std::string scene = csvQuote(r.scenePath);
   char bvh[32] = "";  // empty without a ray caster
   if (r.bvhBuildSeconds >= 0.0) std::snprintf(bvh, sizeof bvh, "%.3f", r.bvhBuildSeconds * 1e3);
   std::snprintf(row, sizeof row, "%s,%s,%d,%d,%d,%d,%llu,%.3f,%s,%.3f,%.3f,%.3f,%d,%.1f,%.3f", scene.c_str(),

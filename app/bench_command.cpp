@@ -15,8 +15,8 @@
 #include "app/bench.h"
 #include "app/bench_peers.h"
 #include "app/commands.h"
+#include "app/csv.h"
 #include "app/sweep_crossover_scene.h"
-#include "app/sweep_table.h"
 #include "common/error.h"
 #include "common/interrupt.h"
 
@@ -154,7 +154,7 @@ void appendPeersCsv(const std::string& path, const BenchResult& ours, const Spre
   if (fresh)
     f << "scene,renderer,width,height,spp,threads,rastray_median_ms,rastray_cpu_ms,peer,peer_median_ms,"
          "peer_min_ms,peer_max_ms,peer_cpu_ms,ratio,cpu_ratio\n";
-  const std::string scene = sweep::csvQuote(ours.scenePath);
+  const std::string scene = csvQuote(ours.scenePath);
   for (const PeerRow& row : rows) {
     if (!row.run.ran) continue;
     char peerCpu[32] = "", cpuRatio[32] = "";  // empty: the peer reports no CPU time

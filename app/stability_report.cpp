@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "app/crossval_report.h"
+#include "app/csv.h"
 #include "common/error.h"
 #include "common/image.h"
 
@@ -38,13 +39,6 @@ Cells cellsOf(const Row& r) {
   c.metric = r.metricName.empty() ? "-" : r.metricName + " = " + fmt("%.4g", r.metric);
   c.seconds = fmt("%.3f", r.seconds);
   return c;
-}
-
-std::string csvQuote(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
 }
 
 nlohmann::json numberOrNull(double v) {

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "app/crossval_report.h"
+#include "app/csv.h"
 #include "app/sweep_crossover_child.h"
 #include "app/sweep_crossover_scene.h"
 #include "common/error.h"
@@ -46,13 +47,6 @@ std::string num(double v, const char* format = "%.6g") {
   char buf[40];
   std::snprintf(buf, sizeof buf, format, v);
   return buf;
-}
-
-std::string csvField(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string out = "\"";
-  for (const char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
 }
 
 std::string bytes(uint64_t v) { return v ? std::to_string(v) : std::string(); }
@@ -273,9 +267,9 @@ std::string toCsv(const std::vector<CellResult>& rows) {
   for (const CellResult& r : rows) {
     out += std::to_string(r.triangles) + "," + std::to_string(r.width) + "," + std::to_string(r.height) +
            "," + std::to_string(uint64_t(r.width) * uint64_t(r.height)) + "," + r.renderer + "," +
-           csvField(r.status) + "," + std::to_string(r.runs) + "," + num(r.visibilitySeconds) + "," +
+           csvQuote(r.status) + "," + std::to_string(r.runs) + "," + num(r.visibilitySeconds) + "," +
            num(r.shadedSeconds) + "," + num(r.bvhBuildSeconds) + "," + num(r.processSeconds) + "," +
-           bytes(r.visibilityPeakRssBytes) + "," + bytes(r.shadedPeakRssBytes) + "," + csvField(r.detail) +
+           bytes(r.visibilityPeakRssBytes) + "," + bytes(r.shadedPeakRssBytes) + "," + csvQuote(r.detail) +
            "\n";
   }
   return out;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/csv.h"
 #include "common/error.h"
 
 namespace rastray::sweep {
@@ -19,17 +20,6 @@ const std::vector<std::string> kErrorColumns = {
     "rms_error",      "max_error",     "perceptual_error", "visibility_error", "visibility_shared_edge",
     "depth_mean_abs", "depth_max_abs", "depth_mean_rel",   "depth_max_rel",    "depth_pixels",
     "pixels"};
-
-}  // namespace
-
-std::string csvQuote(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string out = "\"";
-  for (const char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
-namespace {
 
 // 17 significant digits: enough for any double to read back bit for bit.
 std::string num(double v) {
@@ -93,44 +83,6 @@ void setNumbers(CellResult& r, const std::vector<double>& v) {
   e.depthPixels = uint64_t(v[i++]);
   e.pixels = uint64_t(v[i++]);
 }
-
-}  // namespace
-
-bool readCsvRecord(std::istream& in, std::vector<std::string>& fields) {
-  fields.clear();
-  std::string field;
-  bool quoted = false, any = false;
-  char c;
-  while (in.get(c)) {
-    any = true;
-    if (quoted) {
-      if (c == '"') {
-        if (in.peek() == '"') {
-          in.get(c);
-          field += '"';
-        } else {
-          quoted = false;
-        }
-      } else {
-        field += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.push_back(field);
-      field.clear();
-    } else if (c == '\n') {
-      break;
-    } else if (c != '\r') {
-      field += c;
-    }
-  }
-  if (!any) return false;
-  fields.push_back(field);
-  return true;
-}
-
-namespace {
 
 nlohmann::json jsonNumber(double v) {
   if (std::isfinite(v)) return v;

@@ -7,7 +7,6 @@
 // CSV, as those strings in JSON).
 #pragma once
 
-#include <istream>
 #include <string>
 #include <vector>
 
@@ -39,12 +38,6 @@ struct SweepMeta {
 std::vector<std::string> csvColumns(const std::vector<VaryAxis>& vary);
 // The columns that hold times: what may differ between two runs of a cell.
 bool isTimeColumn(const std::string& column);
-
-// One CSV field, quoted per RFC 4180 when it holds a comma, quote or line
-// break; and one record read back (false at the end of the input). The
-// sweep's and the benchmark's CSV files both use them.
-std::string csvQuote(const std::string& field);
-bool readCsvRecord(std::istream& in, std::vector<std::string>& fields);
 
 // Header line, then one line per row (RFC 4180 quoting).
 std::string toCsv(const std::vector<VaryAxis>& vary, const std::vector<CellResult>& rows);

@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "app/bench.h"
+#include "app/csv.h"
 #include "app/stability_measure.h"
-#include "app/sweep_table.h"
 #include "tests/app/run_command.h"
 #include "tests/test_files.h"
 
@@ -125,7 +125,7 @@ TEST(Bench, CsvRowMatchesItsHeader) {
   const auto fields = [](const std::string& line) {
     std::istringstream in(line);
     std::vector<std::string> record;
-    sweep::readCsvRecord(in, record);
+    readCsvRecord(in, record);
     return record.size();
   };
   EXPECT_EQ(fields(benchCsvRow(r)), fields(benchCsvHeader()));
@@ -135,7 +135,7 @@ TEST(Bench, CsvRowMatchesItsHeader) {
   EXPECT_EQ(fields(benchCsvRow(r)), fields(benchCsvHeader()));
   std::istringstream row(benchCsvRow(r));
   std::vector<std::string> record;
-  ASSERT_TRUE(sweep::readCsvRecord(row, record));
+  ASSERT_TRUE(readCsvRecord(row, record));
   EXPECT_EQ(record.front(), "a,b.gltf");  // quoted, read back whole
 }
 
