@@ -397,7 +397,7 @@ std::string rayTreeText(const std::vector<TraceEvent>& events, glm::ivec2 pixel)
 }
 
 FrameRenderer::FrameRenderer(const Scene& scene, const RenderSettings& s, const RasterOptions& raster,
-                             const RayOptions& ray)
+                             const RayOptions& ray, std::shared_ptr<RayCaster> sharedCaster)
     : scene_(scene),
       renderer_(s.renderer),
       raster_(raster),
@@ -405,15 +405,22 @@ FrameRenderer::FrameRenderer(const Scene& scene, const RenderSettings& s, const 
       analysis_(analyzeScene(scene)),
       camera_(makeCamera(scene, s.camera.overrides(), s.camera.width(), s.camera.height())) {
   if (renderer_ == RendererKind::Raster) return;
-  const auto start = std::chrono::steady_clock::now();
-  caster_ = std::make_unique<RayCaster>(scene, analysis_, raster.cull);
-  bvhBuildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (sharedCaster) {
+    caster_ = std::move(sharedCaster);
+  } else {
+    const auto start = std::chrono::steady_clock::now();
+    caster_ = std::make_shared<RayCaster>(scene, analysis_, raster.cull);
+    bvhBuildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   caster_->bind(camera_, ray_);
 }
 
 FrameRenderer::~FrameRenderer() = default;
 
 RenderOutput FrameRenderer::frame() {
+  // The caster may be shared (serve) and bound to another frame's camera
+  // and options since: bind this frame's (cheap next to a frame).
+  if (caster_) caster_->bind(camera_, ray_);
   // Each frame reports its own rays (hybrid's shading calls the caster
   // outside RayCaster::render, which restarts them itself).
   if (caster_) caster_->resetCounters();

@@ -120,8 +120,12 @@ class FrameRenderer {
   // settings.finish() must have been called; `raster` and `ray` are the
   // options the renderers run with (settings' own, plus keepSamples and
   // trace requests the caller set); they must outlive this object.
+  // `sharedCaster`: a ray caster (its Embree BVH) already built for this
+  // scene and raster.cull, shared with other FrameRenderers (serve keeps one
+  // per prepared scene); it is bound to this camera and options before each
+  // frame. Null: one is built here when the renderer needs it.
   FrameRenderer(const Scene& scene, const RenderSettings& settings, const RasterOptions& raster,
-                const RayOptions& ray);
+                const RayOptions& ray, std::shared_ptr<RayCaster> sharedCaster = nullptr);
   ~FrameRenderer();
   FrameRenderer(const FrameRenderer&) = delete;
   FrameRenderer& operator=(const FrameRenderer&) = delete;
@@ -130,8 +134,11 @@ class FrameRenderer {
 
   const Camera& camera() const { return camera_; }
   const SceneAnalysis& analysis() const { return analysis_; }
-  // Seconds the Embree scene took to build; negative without a ray caster.
+  // Seconds the Embree scene took to build here; negative without a ray
+  // caster or with a shared one.
   double bvhBuildSeconds() const { return bvhBuildSeconds_; }
+  // The ray caster this renderer uses (null for the rasterizer alone).
+  const std::shared_ptr<RayCaster>& caster() const { return caster_; }
 
  private:
   const Scene& scene_;
@@ -140,7 +147,7 @@ class FrameRenderer {
   const RayOptions& ray_;
   SceneAnalysis analysis_;
   Camera camera_;
-  std::unique_ptr<RayCaster> caster_;
+  std::shared_ptr<RayCaster> caster_;
   double bvhBuildSeconds_ = -1.0;
 };
 

@@ -98,6 +98,18 @@ std::shared_ptr<const Scene> SceneCache::loaded(const std::string& path) {
 }
 
 std::shared_ptr<const Scene> SceneCache::prepared(const std::string& path, const RenderSettings& settings) {
+  const std::string key = preparedKey(path, settings);
+  if (auto scene = prepared_.find(key)) return scene;
+  // A copy of the loaded scene prepared as loadSceneForRender prepares a
+  // freshly loaded one: rebaseScene rounds again from worldPositions.
+  Scene scene = *loaded(path);
+  prepareSceneForRender(scene, settings);
+  auto shared = std::make_shared<const Scene>(std::move(scene));
+  prepared_.insert(key, shared);
+  return shared;
+}
+
+std::string SceneCache::preparedKey(const std::string& path, const RenderSettings& settings) {
   // The rebasing point depends only on the origin mode and, for the camera
   // origin, on the eye (given, or the file's chosen camera).
   std::string key = path + (settings.renderOrigin == RenderOrigin::World ? "\x1fworld"
@@ -117,14 +129,7 @@ std::shared_ptr<const Scene> SceneCache::prepared(const std::string& path, const
         "camera " +
         std::to_string(*overrides.camera);
   key += "\x1flights " + settings.lights;
-  if (auto scene = prepared_.find(key)) return scene;
-  // A copy of the loaded scene prepared as loadSceneForRender prepares a
-  // freshly loaded one: rebaseScene rounds again from worldPositions.
-  Scene scene = *loaded(path);
-  prepareSceneForRender(scene, settings);
-  auto shared = std::make_shared<const Scene>(std::move(scene));
-  prepared_.insert(key, shared);
-  return shared;
+  return key;
 }
 
 std::shared_ptr<PreparedFrame> SceneCache::frame(const std::string& path,
@@ -144,8 +149,25 @@ std::shared_ptr<PreparedFrame> SceneCache::frame(const std::string& path,
   frame->memory = estimateRenderMemory(*frame->scene, settings);
   checkMemory(frame->memory, settings.memory, frame->scene->path, "",
               describeRenderWork(settings, toString(settings.renderer)));
+  // The BVH depends on the prepared scene and the culling mode alone: a
+  // frame of other options or another camera over the same prepared scene
+  // (with --origin world, any camera) shares the caster built first.
+  std::shared_ptr<RayCaster> caster;
+  const std::string casterKey = preparedKey(path, settings) +
+                                "\x1f"
+                                "cull " +
+                                std::to_string(int(settings.raster.cull));
+  if (settings.renderer != RendererKind::Raster) {
+    if (auto found = casters_.find(casterKey)) {
+      if (found->scene == frame->scene) caster = found->caster;
+    }
+  }
   frame->renderer =
-      std::make_unique<FrameRenderer>(*frame->scene, frame->settings, frame->raster, frame->ray);
+      std::make_unique<FrameRenderer>(*frame->scene, frame->settings, frame->raster, frame->ray, caster);
+  frame->builtBvh = frame->renderer->bvhBuildSeconds() >= 0.0;
+  if (frame->builtBvh)
+    casters_.insert(casterKey,
+                    std::make_shared<SharedCaster>(SharedCaster{frame->scene, frame->renderer->caster()}));
   frames_.insert(key, frame);
   return frame;
 }
@@ -169,7 +191,7 @@ RenderRun renderPrepared(PreparedFrame& frame) {
   run.output = frame.renderer->frame();
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.memoryEstimate = frame.memory;
-  if (!frame.reused && frame.renderer->bvhBuildSeconds() >= 0.0) {
+  if (!frame.reused && frame.builtBvh) {
     run.output.timings.insert(run.output.timings.begin(),
                               {"raytrace.bvh_build", frame.renderer->bvhBuildSeconds()});
     run.seconds += frame.renderer->bvhBuildSeconds();

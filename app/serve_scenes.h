@@ -7,9 +7,10 @@
 //
 // SceneCache keeps, per scene file, the parsed scene with its decoded
 // textures (and their mip chains); per render origin the scene rebased as
-// `render` rebases it; per full set of render settings a FrameRenderer
-// (analysis, camera and the Embree BVH, built once); and per crossval
-// settings the comparison behind the maps. The caches are bounded (least
+// `render` rebases it; per rebased scene and culling mode the ray caster
+// with its Embree BVH; per full set of render settings a FrameRenderer
+// (analysis and camera, sharing that caster); and per crossval settings
+// the comparison behind the maps. The caches are bounded (least
 // recently used first out). Not thread-safe: the server renders one
 // request at a time and calls it under that lock.
 #pragma once
@@ -88,6 +89,13 @@ struct PreparedFrame {
   std::unique_ptr<FrameRenderer> renderer;
   MemoryEstimate memory;  // checked against settings.memory (--max-memory) before preparing
   bool reused = false;    // true once a later request found it in the cache
+  bool builtBvh = false;  // its renderer built a BVH (else none, or a shared one)
+};
+
+// A ray caster (its Embree BVH) with the prepared scene it was built over.
+struct SharedCaster {
+  std::shared_ptr<const Scene> scene;
+  std::shared_ptr<RayCaster> caster;
 };
 
 class SceneCache {
@@ -112,7 +120,11 @@ class SceneCache {
  private:
   LruCache<const Scene> loaded_{8};
   LruCache<const Scene> prepared_{3};
+  // The cache key of prepared(path, settings).
+  static std::string preparedKey(const std::string& path, const RenderSettings& settings);
+
   LruCache<PreparedFrame> frames_{4};
+  LruCache<SharedCaster> casters_{2};            // per prepared scene and culling mode
   LruCache<const CrossvalResult> crossvals_{1};  // deep frames of three renders: the largest entries
 };
 

@@ -181,7 +181,12 @@ json ExplorerServer::Impl::imageFrame(const RequestParameters& r, const std::str
   const RenderRun run = renderPrepared(*prepared);
   png = scratch.png([&](const std::string& file) { writePng(file, run.output.image); });
   json work = ordered(renderReportJson(*prepared->scene, s, run));
-  work["preparation"] = prepared->reused ? "reused" : "built";
+  // Where the BVH came from: none (the rasterizer alone), built by this
+  // request, or kept from an earlier one (the same frame, or another frame
+  // over the same rebased scene and culling mode).
+  work["preparation"] = s.renderer == RendererKind::Raster        ? "none"
+                        : prepared->builtBvh && !prepared->reused ? "built"
+                                                                  : "reused";
   return {{"renders", json::array({work})}};
 }
 

@@ -246,7 +246,7 @@ function workOf(render) {
   const box = el('details');
   box.open = true;
   box.append(el('summary', render.renderer + ': ' + (render.seconds * 1000).toFixed(1) + ' ms' +
-                (render.preparation ? ' (BVH ' + render.preparation + ')' : '')));
+                (render.preparation && render.preparation !== 'none' ? ' (BVH ' + render.preparation + ')' : '')));
   const left = el('ul', '', 'left-out');
   for (const p of render.passesLeftOut) left.append(el('li', p));
   const run = el('ul', '', 'passes-run');

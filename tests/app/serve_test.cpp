@@ -168,6 +168,49 @@ TEST_F(ServeTest, PreparedRendererIsKeptBetweenRequests) {
   EXPECT_EQ(a["image"], b["image"]);
 }
 
+// The BVH depends on the rebased scene and the culling mode only: changing
+// spp or the shadow method keeps it, and so does moving the camera under
+// --origin world; moving the eye under --origin camera (the default)
+// rebases the scene and builds another. Every image is the command line's.
+TEST_F(ServeTest, TheBvhIsSharedAcrossOptionsAndWorldOriginCameras) {
+  // cull=front: a BVH no other test of this server's suite has built.
+  const std::string options = "&size=40,30&renderer=hybrid&cull=front";
+  const std::string base = "/api/frame?" + cornell() + options;
+  auto work = [&](const std::string& extra) {
+    const auto r = get(base + extra);
+    EXPECT_TRUE(r && r->status == 200) << extra << ": " << (r ? r->body : "no response");
+    return r && r->status == 200 ? json::parse(r->body) : json();
+  };
+  auto preparation = [](const json& j) { return j["renders"][0]["preparation"].get<std::string>(); };
+  const json first = work("&shadows=map");
+  EXPECT_EQ(preparation(first), "built");
+  EXPECT_TRUE(first["renders"][0]["timings"].contains("raytrace.bvh_build"));
+  for (const std::string extra : {"&shadows=rays", "&shadows=rays&spp=4", "&max-depth=1"}) {
+    const json j = work(extra);
+    EXPECT_EQ(preparation(j), "reused") << extra;
+    EXPECT_FALSE(j["renders"][0]["timings"].contains("raytrace.bvh_build")) << extra;
+    // The same image as the command line the page shows.
+    const auto words = shellWords(j["command"].get<std::string>());
+    std::vector<std::string> args(words.begin() + 1, words.end());
+    const std::string out = (base_ / "shared.png").string();
+    for (size_t i = 0; i + 1 < args.size(); ++i)
+      if (args[i] == "-o") args[i + 1] = out;
+    const auto run = test::runRastray(args);
+    ASSERT_EQ(run.status, 0) << run.err;
+    const auto image = get("/api/image?" + cornell() + options + extra);
+    EXPECT_EQ(image->body, slurp(out)) << extra;
+  }
+  // The frame that built the caster renders its own camera and options
+  // again after the others have bound theirs.
+  EXPECT_EQ(work("&shadows=map")["image"], first["image"]);
+  EXPECT_EQ(preparation(work("&origin=world&eye=0,0,3.5")), "built");
+  EXPECT_EQ(preparation(work("&origin=world&eye=0.5,0.2,3.4")), "reused");
+  EXPECT_EQ(preparation(work("&eye=0.5,0.2,3.4")), "built");
+  const auto raster = get("/api/frame?" + cornell() + "&size=40,30&renderer=raster");
+  ASSERT_TRUE(raster && raster->status == 200);
+  EXPECT_EQ(preparation(json::parse(raster->body)), "none");
+}
+
 TEST_F(ServeTest, MapsComeFromCrossvalAndMatchItsReport) {
   const std::string settings = "&size=48,36&spp=4&shadow-map-size=256";
   for (const char* view : {"mismatch", "depth-diff", "color-diff"}) {
