@@ -66,21 +66,33 @@ std::vector<std::string> sizeArgs(int w, int h, int spp) {
   return {"--size", std::to_string(w), std::to_string(h), "--spp", std::to_string(spp)};
 }
 
+// Crossval of a w × h render at 1 spp, and at 4 too unless --quick: per
+// sample count the raster row, then the hybrid row (crossvalRow), the
+// 1-spp raster row with the crossval images. `measure(row, result, hybrid,
+// spp)` completes each row first and returns the rows to add after it.
+template <class Measure>
+std::vector<Row> crossvalRowsPerSpp(const std::string& name, const CaseContext& ctx, const std::string& path,
+                                    int w, int h, Measure measure) {
+  std::vector<Row> rows;
+  for (int spp : ctx.quick ? std::vector<int>{1} : std::vector<int>{1, 4}) {
+    const CrossvalResult r = crossvalidateVariant(ctx, path, sizeArgs(w, h, spp));
+    for (bool hybrid : {false, true}) {
+      Row row = crossvalRow(name, "spp " + std::to_string(spp), r, hybrid);
+      const std::vector<Row> after = measure(row, r, hybrid, spp);
+      if (!hybrid && spp == 1) addCrossvalImages(ctx, &row, name, "spp1", r);
+      rows.push_back(row);
+      rows.insert(rows.end(), after.begin(), after.end());
+    }
+  }
+  return rows;
+}
+
 // ---------------------------------------------------------------------------
 // Sub-pixel triangles
 
 std::vector<Row> runSubpixel(const std::string& name, const CaseContext& ctx, const std::string& path) {
-  std::vector<Row> rows;
-  for (int spp : ctx.quick ? std::vector<int>{1} : std::vector<int>{1, 4}) {
-    const std::string variant = "spp " + std::to_string(spp);
-    const CrossvalResult r =
-        crossvalidateVariant(ctx, path, sizeArgs(kSubpixelImageSize, kSubpixelImageSize, spp));
-    Row raster = crossvalRow(name, variant, r, false);
-    if (spp == 1) addCrossvalImages(ctx, &raster, name, "spp1", r);
-    rows.push_back(raster);
-    rows.push_back(crossvalRow(name, variant, r, true));
-  }
-  return rows;
+  return crossvalRowsPerSpp(name, ctx, path, kSubpixelImageSize, kSubpixelImageSize,
+                            [](Row&, const CrossvalResult&, bool, int) { return std::vector<Row>(); });
 }
 
 // ---------------------------------------------------------------------------
@@ -129,28 +141,22 @@ CoverageCounts sliverCoverage(const SliverLayout& L, const DeepImage& deep, int 
 std::vector<Row> runSlivers(const std::string& name, const CaseContext& ctx, const std::string& path) {
   SliverLayout layout;
   sliverScene(&layout);  // the layout the written scene was made from
-  std::vector<Row> rows;
-  for (int spp : ctx.quick ? std::vector<int>{1} : std::vector<int>{1, 4}) {
-    const std::string variant = "spp " + std::to_string(spp);
-    const CrossvalResult r =
-        crossvalidateVariant(ctx, path, sizeArgs(layout.frame.width, layout.frame.height, spp));
-    for (bool hybrid : {false, true}) {
-      Row row = crossvalRow(name, variant, r, hybrid);
-      const CoverageCounts mine = sliverCoverage(layout, (hybrid ? r.hybrid : r.raster).output.samples, spp);
-      const CoverageCounts ray = sliverCoverage(layout, r.raytrace.output.samples, spp);
-      row.metricName = "holes + double-covered samples (this renderer, ray caster)";
-      row.metric = double(mine.holes + mine.doubles + ray.holes + ray.doubles);
-      row.property = "0 genuine mismatches, 0 holes, 0 double coverage in either renderer, no NaN/Inf";
-      row.pass = row.pass && row.metric == 0.0;
-      if (ctx.progress)
-        ctx.progress(name + " " + row.variant + ": interior " + std::to_string(mine.interior) + ", holes " +
-                     std::to_string(mine.holes) + "/" + std::to_string(ray.holes) + ", double " +
-                     std::to_string(mine.doubles) + "/" + std::to_string(ray.doubles));
-      if (!hybrid && spp == 1) addCrossvalImages(ctx, &row, name, "spp1", r);
-      rows.push_back(row);
-    }
-  }
-  return rows;
+  return crossvalRowsPerSpp(
+      name, ctx, path, layout.frame.width, layout.frame.height,
+      [&](Row& row, const CrossvalResult& r, bool hybrid, int spp) {
+        const CoverageCounts mine =
+            sliverCoverage(layout, (hybrid ? r.hybrid : r.raster).output.samples, spp);
+        const CoverageCounts ray = sliverCoverage(layout, r.raytrace.output.samples, spp);
+        row.metricName = "holes + double-covered samples (this renderer, ray caster)";
+        row.metric = double(mine.holes + mine.doubles + ray.holes + ray.doubles);
+        row.property = "0 genuine mismatches, 0 holes, 0 double coverage in either renderer, no NaN/Inf";
+        row.pass = row.pass && row.metric == 0.0;
+        if (ctx.progress)
+          ctx.progress(name + " " + row.variant + ": interior " + std::to_string(mine.interior) + ", holes " +
+                       std::to_string(mine.holes) + "/" + std::to_string(ray.holes) + ", double " +
+                       std::to_string(mine.doubles) + "/" + std::to_string(ray.doubles));
+        return std::vector<Row>();
+      });
 }
 
 // ---------------------------------------------------------------------------
@@ -191,45 +197,35 @@ std::vector<Row> runTiling(const std::string& name, const CaseContext& ctx, cons
                            uint32_t seed) {
   TilingLayout layout;
   pixelAlignedScene(&layout, seed);
-  std::vector<Row> rows;
-  for (int spp : ctx.quick ? std::vector<int>{1} : std::vector<int>{1, 4}) {
-    const std::string variant = "spp " + std::to_string(spp);
-    const CrossvalResult r =
-        crossvalidateVariant(ctx, path, sizeArgs(layout.frame.width, layout.frame.height, spp));
-    for (bool hybrid : {false, true}) {
-      Row row = crossvalRow(name, variant, r, hybrid);
-      const TieCounts mine = tilingTies(layout, (hybrid ? r.hybrid : r.raster).output.samples, spp);
-      const TieCounts ray = tilingTies(layout, r.raytrace.output.samples, spp);
-      row.metricName = "samples not owned by the exact top-left triangle (this renderer)";
-      row.metric = double(mine.ownerDiffers());
-      row.property =
-          "0 genuine mismatches; the rasterizer's owner of every sample is the exact top-left one; every "
-          "interior "
-          "sample covered exactly once in both renderers";
-      row.pass = row.pass && mine.ownerDiffers() == 0 && mine.interiorWrong == 0 && ray.interiorWrong == 0;
-      if (ctx.progress)
-        ctx.progress(name + " " + row.variant + ": owner differs " + std::to_string(mine.ownerDiffers()) +
-                     " (ray caster " + std::to_string(ray.innerDiffers) + " inside, " +
-                     std::to_string(ray.outlineDiffers) + " on the outline) of " +
-                     std::to_string(mine.samples) + ", interior not once " +
-                     std::to_string(mine.interiorWrong) + "/" + std::to_string(ray.interiorWrong));
-      if (!hybrid && spp == 1) addCrossvalImages(ctx, &row, name, "spp1", r);
-      rows.push_back(row);
-      if (!hybrid) {
+  return crossvalRowsPerSpp(
+      name, ctx, path, layout.frame.width, layout.frame.height,
+      [&](Row& row, const CrossvalResult& r, bool hybrid, int spp) {
+        const TieCounts mine = tilingTies(layout, (hybrid ? r.hybrid : r.raster).output.samples, spp);
+        const TieCounts ray = tilingTies(layout, r.raytrace.output.samples, spp);
+        row.metricName = "samples not owned by the exact top-left triangle (this renderer)";
+        row.metric = double(mine.ownerDiffers());
+        row.property =
+            "0 genuine mismatches; the rasterizer's owner of every sample is the exact top-left one; "
+            "every interior sample covered exactly once in both renderers";
+        row.pass = row.pass && mine.ownerDiffers() == 0 && mine.interiorWrong == 0 && ray.interiorWrong == 0;
+        if (ctx.progress)
+          ctx.progress(name + " " + row.variant + ": owner differs " + std::to_string(mine.ownerDiffers()) +
+                       " (ray caster " + std::to_string(ray.innerDiffers) + " inside, " +
+                       std::to_string(ray.outlineDiffers) + " on the outline) of " +
+                       std::to_string(mine.samples) + ", interior not once " +
+                       std::to_string(mine.interiorWrong) + "/" + std::to_string(ray.interiorWrong));
+        if (hybrid) return std::vector<Row>();
         // The ray caster's tie decisions, shown (SPEC §3 lets it pick
         // either triangle on a shared edge; outline ties are silhouettes).
         Row tie;
         tie.caseName = name;
-        tie.variant = "raytrace ties, " + variant;
+        tie.variant = "raytrace ties, spp " + std::to_string(spp);
         tie.nanInf = countNanInf(r.raytrace.output);
         tie.metricName = "samples not owned by the exact top-left triangle (ray caster)";
         tie.metric = double(ray.ownerDiffers());
         tie.seconds = r.raytrace.seconds;
-        rows.push_back(tie);
-      }
-    }
-  }
-  return rows;
+        return std::vector<Row>{tie};
+      });
 }
 
 // ---------------------------------------------------------------------------

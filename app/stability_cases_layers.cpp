@@ -205,6 +205,15 @@ Stack extremeLayers(float alpha) {
   return st;
 }
 
+// One triangle as a mesh (an instance) of its own.
+void addTriangle(GltfScene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, int material) {
+  GltfMesh m;
+  m.positions = {a, b, c};
+  m.indices = {0, 1, 2};
+  m.material = material;
+  s.meshes.push_back(m);
+}
+
 // --- near plane and w = 0 ---------------------------------------------------------------
 //
 // Camera at the origin looking down −Z (yfov 60°, znear 0.1, infinite far).
@@ -219,17 +228,14 @@ GltfScene clipScene() {
   GltfScene s;
   s.materials = {emissiveMaterial({0.9f, 0.2f, 0.2f}, 1.0f), emissiveMaterial({0.2f, 0.9f, 0.2f}, 1.0f),
                  emissiveMaterial({0.2f, 0.2f, 0.9f}, 1.0f), emissiveMaterial({0.9f, 0.9f, 0.2f}, 1.0f)};
-  auto tri = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, int material) {
-    GltfMesh m;
-    m.positions = {a, b, c};
-    m.indices = {0, 1, 2};
-    m.material = material;
-    s.meshes.push_back(m);
-  };
-  tri({-1.5f, 0.3f, -2.0f}, {1.5f, 0.3f, -2.0f}, {0.0f, 1.5f, 3.0f}, 0);    // vertex behind the eye
-  tri({-1e6f, -0.5f, 1e6f}, {1e6f, -0.5f, 1e6f}, {0.0f, -0.5f, -1e6f}, 1);  // 2e6 across the eye plane
-  tri({3.0f, 0.3f, 0.0f}, {-0.6f, 0.05f, -1.0f}, {0.2f, 0.3f, -1.0f}, 2);   // a vertex at w = 0
-  tri({0.0f, 0.0f, 0.0f}, {-2.0f, 0.5f, -4.0f}, {-1.0f, 1.5f, -4.0f}, 3);   // a vertex at the eye
+  // vertex behind the eye
+  addTriangle(s, {-1.5f, 0.3f, -2.0f}, {1.5f, 0.3f, -2.0f}, {0.0f, 1.5f, 3.0f}, 0);
+  // 2e6 across the eye plane
+  addTriangle(s, {-1e6f, -0.5f, 1e6f}, {1e6f, -0.5f, 1e6f}, {0.0f, -0.5f, -1e6f}, 1);
+  // a vertex at w = 0
+  addTriangle(s, {3.0f, 0.3f, 0.0f}, {-0.6f, 0.05f, -1.0f}, {0.2f, 0.3f, -1.0f}, 2);
+  // a vertex at the eye
+  addTriangle(s, {0.0f, 0.0f, 0.0f}, {-2.0f, 0.5f, -4.0f}, {-1.0f, 1.5f, -4.0f}, 3);
   GltfCamera c = lookDownZ(60.0 * kPi / 180.0);
   s.camera = c;
   return s;
@@ -284,18 +290,16 @@ GltfScene degenerateScene() {
   s.materials = {emissiveMaterial({0.5f, 0.5f, 0.5f}, 1.0f), emissiveMaterial({1.0f, 0.0f, 0.0f}, 1.0f),
                  emissiveMaterial({0.0f, 1.0f, 0.0f}, 0.5f)};
   s.meshes.push_back(quadAt(-10.0f, 20.0f, 0));
-  auto tri = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, int material) {
-    GltfMesh m;
-    m.positions = {a, b, c};
-    m.indices = {0, 1, 2};
-    m.material = material;
-    s.meshes.push_back(m);
-  };
-  tri({0.0f, 0.0f, -5.0f}, {1.0f, 1.0f, -5.0f}, {2.0f, 2.0f, -5.0f}, 1);      // collinear
-  tri({0.5f, -0.5f, -5.0f}, {0.5f, -0.5f, -5.0f}, {0.5f, -0.5f, -5.0f}, 1);   // three equal points
-  tri({-1e6f, 0.25f, -5.0f}, {1e6f, 0.25f, -5.0f}, {3.0f, 0.25f, -5.0f}, 1);  // needle 2e6 long
-  tri({0.3f, 0.1f, -2.0f}, {0.3f, 0.1f, -4.0f}, {0.3f, 0.1f, -8.0f}, 1);      // edge-on, along the view
-  tri({0.0f, 0.0f, -4.0f}, {-1.0f, -1.0f, -4.0f}, {-2.0f, -2.0f, -4.0f}, 2);  // collinear, BLEND
+  // collinear
+  addTriangle(s, {0.0f, 0.0f, -5.0f}, {1.0f, 1.0f, -5.0f}, {2.0f, 2.0f, -5.0f}, 1);
+  // three equal points
+  addTriangle(s, {0.5f, -0.5f, -5.0f}, {0.5f, -0.5f, -5.0f}, {0.5f, -0.5f, -5.0f}, 1);
+  // needle 2e6 long
+  addTriangle(s, {-1e6f, 0.25f, -5.0f}, {1e6f, 0.25f, -5.0f}, {3.0f, 0.25f, -5.0f}, 1);
+  // edge-on, along the view
+  addTriangle(s, {0.3f, 0.1f, -2.0f}, {0.3f, 0.1f, -4.0f}, {0.3f, 0.1f, -8.0f}, 1);
+  // collinear, BLEND
+  addTriangle(s, {0.0f, 0.0f, -4.0f}, {-1.0f, -1.0f, -4.0f}, {-2.0f, -2.0f, -4.0f}, 2);
   s.camera = lookDownZ();
   return s;
 }
