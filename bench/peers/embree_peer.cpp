@@ -218,8 +218,7 @@ int main(int argc, char** argv) {
       "rastray_embree_peer: exports rastray's flattened scene to OBJ (cached in --work-dir) and times "
       "Embree's `viewer --benchmark` on it with an explicit camera; the last line is 'median frame: <ms> ms'",
       "rastray_embree_peer"};
-  app.add_option("scene", o.scenePath, "glTF scene (.gltf or .glb)")->required();
-  addCameraOptions(app, o.camera);
+  addSceneOptions(app, o.scenePath, o.camera);
   app.add_option("--work-dir", o.workDir, "where the OBJ is cached and the viewer's log is kept")->required();
   app.add_option("--frames", o.frames, "timed frames, after one warm-up frame");
   app.add_option("--threads", o.threads, "the viewer's threads (default: every core)");

@@ -486,8 +486,7 @@ int main(int argc, char** argv) {
       "rastray_osmesa_peer: times OpenGL (Mesa llvmpipe through OSMesa) on rastray's flattened scene "
       "with an explicit camera; the last line is 'median frame: <ms> ms'",
       "rastray_osmesa_peer"};
-  app.add_option("scene", o.scenePath, "glTF scene (.gltf or .glb)")->required();
-  addCameraOptions(app, o.camera);
+  addSceneOptions(app, o.scenePath, o.camera);
   app.add_option("--spp", o.spp, "samples per pixel (MSAA when > 1)");
   app.add_option("--frames", o.frames, "timed frames, after one warm-up frame");
   app.add_option("--threads", o.threads,

@@ -40,7 +40,8 @@ void printErrorLine(const std::string& message) {
 
 }  // namespace
 
-void addCameraOptions(CLI::App& app, PeerCameraArgs& args) {
+void addSceneOptions(CLI::App& app, std::string& scenePath, PeerCameraArgs& args) {
+  app.add_option("scene", scenePath, "glTF scene (.gltf or .glb)")->required();
   app.add_option("--size", args.size, "image width and height in pixels")->expected(2)->required();
   app.add_option("--eye", args.eye, "eye position (file space)")->expected(3);
   app.add_option("--forward", args.forward, "view direction (need not be unit)")->expected(3);

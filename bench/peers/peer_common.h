@@ -33,8 +33,10 @@ struct PeerCameraArgs {
   std::string zfar;  // a number or "inf"; empty: not given (inf with an explicit camera)
 };
 
-// Registers SCENE's camera options on `app` (everything above).
-void addCameraOptions(CLI::App& app, PeerCameraArgs& args);
+// Registers what every peer takes first: the positional SCENE (a glTF
+// file, required) into `scenePath`, then its camera options (everything
+// above) into `camera`.
+void addSceneOptions(CLI::App& app, std::string& scenePath, PeerCameraArgs& camera);
 
 // Rebases `scene` (freshly loaded, origin 0) on --origin (default: the
 // eye, rastray's `--origin camera`) and returns the camera in that frame.
