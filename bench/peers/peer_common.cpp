@@ -40,23 +40,23 @@ void printErrorLine(const std::string& message) {
 
 }  // namespace
 
-void addSceneOptions(CLI::App& app, std::string& scenePath, PeerCameraArgs& args) {
+void addSceneOptions(CLI::App& app, std::string& scenePath, PeerCameraArgs& camera) {
   app.add_option("scene", scenePath, "glTF scene (.gltf or .glb)")->required();
-  app.add_option("--size", args.size, "image width and height in pixels")->expected(2)->required();
-  app.add_option("--eye", args.eye, "eye position (file space)")->expected(3);
-  app.add_option("--forward", args.forward, "view direction (need not be unit)")->expected(3);
-  app.add_option("--up", args.up, "up vector (re-orthogonalised against --forward)")->expected(3);
-  app.add_option("--origin", args.origin,
+  app.add_option("--size", camera.size, "image width and height in pixels")->expected(2)->required();
+  app.add_option("--eye", camera.eye, "eye position (file space)")->expected(3);
+  app.add_option("--forward", camera.forward, "view direction (need not be unit)")->expected(3);
+  app.add_option("--up", camera.up, "up vector (re-orthogonalised against --forward)")->expected(3);
+  app.add_option("--origin", camera.origin,
                  "render origin the scene is rebased on before rounding to float (default: the eye)")
       ->expected(3);
-  app.add_option("--projection", args.projection, "perspective or orthographic")
+  app.add_option("--projection", camera.projection, "perspective or orthographic")
       ->check(CLI::IsMember({"perspective", "orthographic"}));
-  app.add_option("--yfov", args.yfovDegrees, "vertical field of view in degrees (perspective)");
-  app.add_option("--aspect", args.aspect, "aspect ratio (default: width / height)");
-  app.add_option("--xmag", args.xmag, "orthographic half width");
-  app.add_option("--ymag", args.ymag, "orthographic half height");
-  app.add_option("--znear", args.znear, "near plane distance");
-  app.add_option("--zfar", args.zfar, "far plane distance, or inf (default: inf, or the file camera's)");
+  app.add_option("--yfov", camera.yfovDegrees, "vertical field of view in degrees (perspective)");
+  app.add_option("--aspect", camera.aspect, "aspect ratio (default: width / height)");
+  app.add_option("--xmag", camera.xmag, "orthographic half width");
+  app.add_option("--ymag", camera.ymag, "orthographic half height");
+  app.add_option("--znear", camera.znear, "near plane distance");
+  app.add_option("--zfar", camera.zfar, "far plane distance, or inf (default: inf, or the file camera's)");
 }
 
 Camera resolveCamera(Scene& scene, const PeerCameraArgs& args) {
