@@ -171,6 +171,12 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
     {"--max-depth", kTraced, OptionCondition::Always, "Deepest secondary ray (reflection/refraction)",
      RASTRAY_BIND(
          cmd.add_option(name, s.shading.maxDepth, help)->check(CLI::Range(0, 64))->capture_default_str())},
+    {"--no-reflection", kTraced, OptionCondition::Always,
+     "Trace no reflection ray (mirror or Fresnel); that part of the colour is black",
+     RASTRAY_BIND(cmd.add_flag("!" + name, s.shading.reflection, help))},
+    {"--no-refraction", kTraced, OptionCondition::Always,
+     "Trace no refraction ray; that part of the colour is black",
+     RASTRAY_BIND(cmd.add_flag("!" + name, s.shading.refraction, help))},
     {"--transparency-cutoff", kTraced, OptionCondition::Always,
      "Stop compositing along a ray once the remaining transmittance is below this",
      RASTRAY_BIND(cmd.add_option(name, s.ray.transparencyCutoff, help)

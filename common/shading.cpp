@@ -140,14 +140,14 @@ glm::vec4 Shader::shade(const SurfacePoint& p, const glm::dvec3& direction, cons
     const double F = t > 0.0f ? fresnelDielectric(cosI, eta) : 0.0;
     const float reflectWeight = w + t * float(F);
     const glm::dvec3 reflected = reflect(direction, n);
-    if (reflectWeight * throughput >= options_.minThroughput) {
+    if (options_.reflection && reflectWeight * throughput >= options_.minThroughput) {
       // Mirrors tint by the base colour; Fresnel reflection of glass does not.
       const glm::vec3 tint = (w * c + glm::vec3(t * float(F))) / reflectWeight;
       const float weight = reflectWeight * glm::length(tint) / std::sqrt(3.0f);
       L += reflectWeight * tint *
            secondary_->radiance(p, reflected, RayKind::Reflection, depth + 1, throughput * weight);
     }
-    if (t > 0.0f && F < 1.0) {
+    if (options_.refraction && t > 0.0f && F < 1.0) {
       const float refractWeight = t * float(1.0 - F);
       if (refractWeight * throughput >= options_.minThroughput) {
         if (const auto refracted = refract(direction, n, eta))

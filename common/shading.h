@@ -75,6 +75,11 @@ class SecondaryRayTracer {
 struct ShadingOptions {
   int maxDepth = 8;             // secondary rays deeper than this return black
   float minThroughput = 1e-3f;  // secondary rays with less weight are not traced
+  // false: no reflection (mirror or Fresnel) or no refraction ray is traced,
+  // at any depth; its part of the colour is black, as with maxDepth 0
+  // (--no-reflection, --no-refraction: to see what each contributes).
+  bool reflection = true;
+  bool refraction = true;
   TextureFilter textureFilter = TextureFilter::Sampler;
 };
 

@@ -35,8 +35,21 @@ void describeCameraPasses(const SceneAnalysis& analysis, const RasterOptions& op
                              "): " + reason(Work::TransparencyPass));
   else
     out->passesLeftOut.push_back("transparency pass: " + reason(Work::TransparencyPass));
-  if (secondary && (analysis.reflection || analysis.refraction))
-    out->passesRun.push_back("secondary rays: traced (hybrid)");
+  // Hybrid traces the kinds the scene needs and the options keep.
+  const bool reflection = analysis.reflection && options.shading.reflection;
+  const bool refraction = analysis.refraction && options.shading.refraction;
+  if (secondary && analysis.reflection && !options.shading.reflection)
+    out->passesLeftOut.push_back("reflection rays: --no-reflection");
+  if (secondary && analysis.refraction && !options.shading.refraction)
+    out->passesLeftOut.push_back("refraction rays: --no-refraction");
+  if (secondary && (reflection || refraction))
+    out->passesRun.push_back(std::string("secondary rays: traced (hybrid") +
+                             (reflection && refraction ? ""
+                              : reflection             ? ", reflection only"
+                                                       : ", refraction only") +
+                             ")");
+  else if (secondary && (analysis.reflection || analysis.refraction))
+    out->passesLeftOut.push_back("secondary rays: every kind the scene needs is switched off");
   else if (analysis.reflection || analysis.refraction)
     out->passesLeftOut.push_back("secondary rays: pure rasterizer (mirrors and glass see black)");
   else

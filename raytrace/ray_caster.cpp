@@ -24,16 +24,21 @@ void reportPasses(const CasterState& state, RenderOutput* out) {
       (usePackets(state) ? std::to_string(state.options.packetWidth) + "-wide packets" : "single rays") +
       ")");
   const SceneAnalysis& a = state.analysis;
-  auto pass = [&](bool needed, const std::string& name, Work work) {
-    if (needed)
+  auto pass = [&](bool needed, const std::string& name, Work work, const char* offBy = nullptr) {
+    if (needed && offBy)
+      out->passesLeftOut.push_back(name + ": " + offBy);
+    else if (needed)
       out->passesRun.push_back(name);
     else
       for (const WorkDecision& d : a.decisions)
         if (d.work == work) out->passesLeftOut.push_back(name + ": " + d.reason);
   };
+  const ShadingOptions& shading = state.options.shading;
   pass(a.shadows, "shadow rays", Work::Shadows);
-  pass(a.reflection, "reflection rays", Work::ReflectionRays);
-  pass(a.refraction, "refraction rays", Work::RefractionRays);
+  pass(a.reflection, "reflection rays", Work::ReflectionRays,
+       shading.reflection ? nullptr : "--no-reflection");
+  pass(a.refraction, "refraction rays", Work::RefractionRays,
+       shading.refraction ? nullptr : "--no-refraction");
   pass(a.transparency, "transparency continuation", Work::TransparencyPass);
   pass(a.alphaTest, "alpha test (filter callbacks)", Work::AlphaTest);
   if (state.cull != CullMode::None)

@@ -501,7 +501,6 @@ function readControls() {
   }
   const bias = controls().filter((c) => c.dataset.option === 'shadow-bias').map((c) => c.value);
   if (bias.every((v) => v !== '')) o['shadow-bias'] = bias.join(',');
-  if (!$('secondary').checked) o['max-depth'] = '0';
   if (state.sceneInfo) { // the checkboxes exist once the scene is known
     const lights = readLights();
     if (lights === null) delete o.lights; else o.lights = lights;
@@ -525,7 +524,6 @@ function writeControls() {
     else if (c.tagName === 'INPUT') c.value = value;
     else if (value !== '' || name === 'shadows') c.value = value;
   }
-  $('secondary').checked = state.options['max-depth'] !== '0';
   $('width').value = state.size[0];
   $('height').value = state.size[1];
   for (const id of ['renderer', 'view', 'pair']) $(id).value = state[id];
@@ -548,7 +546,6 @@ function updateApplicability() {
     opt.disabled = !all && opt.value !== '' && !renderers.every((r) => shadowsValid(opt.value, r));
   }
   $('peel-layers').hidden = state.options.transparency === undefined || !state.options.transparency.startsWith('peel');
-  if (!$('secondary').checked) document.querySelector('[data-option="max-depth"]').disabled = true;
   $('renderer-label').hidden = all;
   $('swipe-label').hidden = state.view !== 'swipe';
   $('pair-label').hidden = !all;
@@ -656,7 +653,7 @@ async function loadScene(keepCamera) {
 }
 
 function bindEvents() {
-  for (const c of controls().concat([$('secondary'), $('peel-layers'), $('width'), $('height'), $('renderer'),
+  for (const c of controls().concat([$('peel-layers'), $('width'), $('height'), $('renderer'),
                                       $('view'), $('pair'), $('swipe-with')])) {
     c.addEventListener('change', settingsChanged);
   }

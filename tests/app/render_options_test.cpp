@@ -69,6 +69,8 @@ const std::vector<Expected> kExpected = {
     {"--shadow-map-size", kRaster | kHybrid, OptionCondition::ShadowMaps, {"64"}},
     {"--shadow-bias", kRaster | kHybrid, OptionCondition::ShadowMaps, {"1", "1"}},
     {"--max-depth", kRaytrace | kHybrid, OptionCondition::Always, {"2"}},
+    {"--no-reflection", kRaytrace | kHybrid, OptionCondition::Always, {}},
+    {"--no-refraction", kRaytrace | kHybrid, OptionCondition::Always, {}},
     {"--transparency-cutoff", kRaytrace | kHybrid, OptionCondition::Always, {"0.01"}},
     {"--ray-offset", kRaytrace | kHybrid, OptionCondition::Always, {"float-ulps"}},
     {"--no-packets", kRaytrace, OptionCondition::Always, {}},
