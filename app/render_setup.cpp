@@ -418,7 +418,7 @@ FrameRenderer::FrameRenderer(const Scene& scene, const RenderSettings& s, const 
     caster_ = std::make_shared<RayCaster>(scene, analysis_, raster.cull);
     bvhBuildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
-  caster_->bind(camera_, ray_);
+  // Bound to this camera and options in frame(), before each render.
 }
 
 FrameRenderer::~FrameRenderer() = default;

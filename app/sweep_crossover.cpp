@@ -719,7 +719,7 @@ int runCrossover(const CrossoverOptions& options) {
     measureCells(options, meta, onCell, earlier);
   } catch (const Interrupted& e) {
     if (terminal) std::fprintf(stderr, "\r\033[K");
-    const StudyMeta study = studyMeta(options);
+    const StudyMeta& study = meta;  // filled by measureCells before its first check
     const size_t cells = study.triangles.size() * study.sizes.size() * 2;
     std::string account = std::to_string(rows.size()) + " of " + std::to_string(cells) + " cells finished";
     if (!rows.empty()) account += " (in " + json + "; --resume runs the rest)";
