@@ -22,6 +22,7 @@
 #include "common/error.h"
 #include "common/exr_header.h"
 #include "common/memory_budget.h"
+#include "common/rgba8.h"
 #include "common/scene.h"
 
 namespace rastray {
@@ -111,12 +112,6 @@ void writeTextFile(const std::string& path, const std::string& text) {
 }
 
 namespace {
-
-// NaN and negatives to 0, above 1 to 1.
-float unitClamp(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
-
-// [0, 1] to 0..255, rounding to nearest (ties up).
-uint8_t toByte(float unit) { return uint8_t(unit * 255.0f + 0.5f); }
 
 void checkFlat(const FlatImage& image) {
   const size_t n = size_t(image.width) * size_t(image.height);
@@ -352,14 +347,7 @@ void writePng(const std::string& path, const FlatImage& image) {
   // the environment names, and unpremult keeps the colour where alpha is 0,
   // whereas SPEC §4 wants exact sRGB and black there.
   std::vector<uint8_t> rgba(image.color.size() * 4);
-  for (size_t i = 0; i < image.color.size(); ++i) {
-    const glm::vec4 c = image.color[i];
-    for (int k = 0; k < 3; ++k) {
-      const float straight = c.a > 0.0f ? c[k] / c.a : 0.0f;
-      rgba[4 * i + k] = toByte(linearToSrgb(unitClamp(straight)));
-    }
-    rgba[4 * i + 3] = toByte(unitClamp(c.a));
-  }
+  encodeRgba8(image.color.data(), image.color.size(), rgba.data());
   OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeUInt8);
   spec.attribute("oiio:ColorSpace", "sRGB");
   // The bytes are already straight: without this OIIO would un-premultiply

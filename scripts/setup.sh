@@ -11,6 +11,7 @@ packages=(
   libopenimageio-dev openimageio-tools libopencv-core-dev libopenexr-dev
   libtbb-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
   chromium  # the real-browser tests (crossval report, `rastray serve` page, headless), which CI must run, not skip
+  libhwy-dev  # Highway: portable SIMD with run-time dispatch (shading, resolve, PNG encoding)
   libcpp-httplib-dev  # the HTTP server of `rastray serve`, the browser explorer
   libosmesa6-dev embree-tools  # performance peers of `rastray bench --peers`: Mesa llvmpipe, Embree's viewer
   assimp-testmodels  # real-world glTF models: the CAD-like 2CylinderEngine.glb that `rastray bench` measures

@@ -1,0 +1,17 @@
+// The resolve's colour filter (SPEC §3, §4): a pixel's colour is the mean
+// of its samples' premultiplied colours, summed from 0 in sample order and
+// divided by the sample count — the same IEEE operations, in the same
+// order, as the per-sample loop it replaces, so the same bits.
+#pragma once
+
+#include <cstddef>
+
+#include <glm/glm.hpp>
+
+namespace rastray {
+
+// out[p] = (0 + samples[p·spp] + … + samples[p·spp + spp − 1]) / spp for
+// p < pixels, in SIMD lanes (Highway, chosen at run time).
+void boxFilter(const glm::vec4* samples, int spp, size_t pixels, glm::vec4* out);
+
+}  // namespace rastray
