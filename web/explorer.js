@@ -154,9 +154,12 @@ async function requestFrame(preview) {
   }
 }
 
+let previewsShown = 0; // previews on screen so far (the selftest's orbit:MS counts them)
+
 async function showPreview(signal) {
   const j = await fetchFrame(renderQuery(false, state.renderer, {spp: '1'}), signal);
   await loadImage($('image-a'), j.image);
+  ++previewsShown;
   $('image-b').hidden = true;
   for (const id of ['swipe-line', 'label-a', 'label-b']) $(id).hidden = true;
 }
@@ -687,7 +690,10 @@ function bindEvents() {
 // image, each step acts through the same mouse handlers a user reaches:
 // drag:DX,DY orbits (left button, from the image centre, DX, DY CSS pixels)
 // and waits for the refined image; click:X,Y clicks image pixel (X, Y) and
-// waits for the explain panel. The outcome goes to #selftest-result.
+// waits for the explain panel; orbit:MS holds the button down and moves
+// the mouse 4 CSS pixels every 16 ms (a hand orbiting at 60 Hz) for MS
+// milliseconds of real time, and reports the previews shown per second
+// (bench/explorer_previews.sh). The outcome goes to #selftest-result.
 let selftestOn = false;
 function failSelftest(message) {
   if (!selftestOn) return;
@@ -740,6 +746,24 @@ async function selftestClick(px, py) {
          $('overlay').querySelectorAll('.ray').length + ' rays drawn';
 }
 
+async function selftestOrbit(ms) {
+  const refined = new Promise((resolve) => { frameWaiters.push(resolve); });
+  const rect = $('image-a').getBoundingClientRect();
+  const x = Math.round(rect.left + rect.width / 2), y = Math.round(rect.top + rect.height / 2);
+  mouse($('stage'), 'mousedown', x, y);
+  const before = previewsShown, start = performance.now();
+  let step = 0;
+  while (performance.now() - start < ms) {
+    mouse(window, 'mousemove', x + 4 * (++step), y);
+    await new Promise((resolve) => setTimeout(resolve, 16));
+  }
+  const shown = previewsShown - before, seconds = (performance.now() - start) / 1000;
+  mouse(window, 'mouseup', x + 4 * step, y);
+  await refined;
+  return 'orbit ' + shown + ' previews in ' + seconds.toFixed(2) + ' s: ' + (shown / seconds).toFixed(1) +
+         ' previews/s';
+}
+
 async function runSelftest(spec) {
   selftestOn = true;
   const timer = setTimeout(() => failSelftest('timed out'), 60000);
@@ -747,6 +771,8 @@ async function runSelftest(spec) {
     await firstFrame;
     const done = [];
     for (const step of spec.split(';')) {
+      const o = /^orbit:(\d+)$/.exec(step);
+      if (o) { done.push(await selftestOrbit(Number(o[1]))); continue; }
       const m = /^(click|drag):(-?\d+),(-?\d+)$/.exec(step);
       if (!m) throw new Error('unknown step ' + step);
       done.push(await (m[1] === 'click' ? selftestClick : selftestDrag)(Number(m[2]), Number(m[3])));
