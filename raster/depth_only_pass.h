@@ -17,13 +17,14 @@
 // one pass of memory writes, and no clearing pass nor reads.
 //
 // Fast path (CoveragePath::Fast): the camera pass's block coverage
-// (block_coverage.h) and hierarchical depth test (depth_bounds.h) with
-// exact bounds: the largest key of every block row is kept beside the
-// buffer (the pass writes whole block rows, so it knows them), never
-// re-read. Keys are computed eight texels at a time in SIMD doubles
-// (depth_keys.h, the scalar bits), and a block row is tested and written as
-// one SIMD select. Reference path (CoveragePath::Reference): the scalar
-// per-sample walk in (py, px) order.
+// (block_coverage.h) and hierarchical depth test (depth_bounds.h), with a
+// bound per block that is exact once a triangle has drawn all of its rows
+// (the kernels write whole block rows, so they see every key of them) and
+// is never refreshed from memory. Keys are computed eight texels at a time
+// in SIMD doubles (depth_keys.h: the scalar bits), and a block row is
+// tested and written as one SIMD select, in SSE2 or, chosen at run time,
+// AVX2. Reference path (CoveragePath::Reference): the scalar per-sample
+// walk in (py, px) order.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +54,11 @@ struct DepthMap {
 
 using AlphaTestFunction = std::function<bool(const TriangleSetup&, int px, int py, int s)>;
 
+// The fast path's vector width: Best picks AVX2 at run time where the CPU
+// has it, Baseline keeps to SSE2 (x86-64's baseline). Identical keys; the
+// choice is there for the tests that prove it.
+enum class SimdLevel { Best, Baseline };
+
 // One tile of the pass, drawn into its local buffer.
 class DepthOnlyTile {
  public:
@@ -65,11 +71,12 @@ class DepthOnlyTile {
   // samples of blocks the hierarchical test skipped (all would fail).
   void render(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
               const SampleGrid& grid, DepthFormat format, const AlphaTestFunction& alphaTest,
-              DepthPassCounters* counters, CoveragePath path = CoveragePath::Fast);
+              DepthPassCounters* counters, CoveragePath path = CoveragePath::Fast,
+              SimdLevel simd = SimdLevel::Best);
 
   // The key drawn at texel (px, py) of the rect.
   uint32_t key(int px, int py) const {
-    return keys_[size_t(py - rect_.y0) * kTileSize + size_t(px - rect_.x0)];
+    return uint32_t(keys_[size_t(py - rect_.y0) * kTileSize + size_t(px - rect_.x0)]) ^ 0x80000000u;
   }
   const TileRect& rect() const { return rect_; }
 
@@ -79,13 +86,15 @@ class DepthOnlyTile {
 
  private:
   TileRect rect_;
-  alignas(64) uint32_t keys_[kTileSize * kTileSize];
+  // Biased keys (key ^ 2^31 as int32, so that signed SIMD compares order
+  // them), rows of kTileSize.
+  alignas(64) int32_t keys_[kTileSize * kTileSize];
 };
 
 // render then store: the pass over one tile of `map`.
 void rasterDepthOnlyPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
                          const SampleGrid& grid, const TileRect& rect, DepthFormat format,
                          const AlphaTestFunction& alphaTest, DepthMap* map, DepthPassCounters* counters,
-                         CoveragePath path = CoveragePath::Fast);
+                         CoveragePath path = CoveragePath::Fast, SimdLevel simd = SimdLevel::Best);
 
 }  // namespace rastray

@@ -169,7 +169,8 @@ std::vector<TriangleSetup> setupFor(const Scene& scene, const Camera& camera, co
 // The depth-only pass over every tile of a map filled with garbage first
 // (the pass must write every texel).
 Maps depthOnly(const std::vector<TriangleSetup>& setups, const SampleGrid& grid, int w, int h,
-               DepthFormat format, const AlphaTestFunction& alpha, CoveragePath path) {
+               DepthFormat format, const AlphaTestFunction& alpha, CoveragePath path,
+               SimdLevel simd = SimdLevel::Best) {
   DepthMap map(w, h);
   std::fill_n(map.keys.get(), size_t(w) * size_t(h), 0x5A5A5A5Au);
   const TileGrid tiles(w, h);
@@ -177,7 +178,7 @@ Maps depthOnly(const std::vector<TriangleSetup>& setups, const SampleGrid& grid,
   Maps out;
   for (int tile = 0; tile < tiles.count(); ++tile)
     rasterDepthOnlyPass(setups, bins[size_t(tile)], grid, tiles.rect(tile), format, alpha, &map,
-                        &out.counters, path);
+                        &out.counters, path, simd);
   out.keys.assign(map.keys.get(), map.keys.get() + size_t(w) * size_t(h));
   return out;
 }
@@ -207,10 +208,14 @@ void expectSameMaps(const std::vector<TriangleSetup>& setups, const SampleGrid& 
     const AlphaTestFunction& a = alpha ? *alpha : none;
     const std::string label = what + (alpha ? " with alpha test" : "");
     const Maps fast = depthOnly(setups, grid, w, h, format, a, CoveragePath::Fast);
+    const Maps baseline = depthOnly(setups, grid, w, h, format, a, CoveragePath::Fast, SimdLevel::Baseline);
     const Maps slow = depthOnly(setups, grid, w, h, format, a, CoveragePath::Reference);
     const Maps before = keysOnlyDepthPass(setups, grid, w, h, format, a, CoveragePath::Fast);
     const Maps beforeSlow = keysOnlyDepthPass(setups, grid, w, h, format, a, CoveragePath::Reference);
     ASSERT_EQ(fast.keys, slow.keys) << label;
+    ASSERT_EQ(baseline.keys, slow.keys) << label;
+    EXPECT_EQ(baseline.counters.samplesTested, fast.counters.samplesTested) << label;
+    EXPECT_EQ(baseline.counters.samplesPassed, fast.counters.samplesPassed) << label;
     ASSERT_EQ(fast.keys, before.keys) << label;
     ASSERT_EQ(fast.keys, beforeSlow.keys) << label;
     EXPECT_EQ(fast.counters.coverageTests, slow.counters.coverageTests) << label;
