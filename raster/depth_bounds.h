@@ -18,6 +18,15 @@
 
 namespace rastray {
 
+// Set bits of a mask (x86-64's baseline has no POPCNT, so the builtin
+// would call libgcc).
+inline int bitCount(uint64_t m) {
+  m = m - ((m >> 1) & 0x5555555555555555ull);
+  m = (m & 0x3333333333333333ull) + ((m >> 2) & 0x3333333333333333ull);
+  m = (m + (m >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return int((m * 0x0101010101010101ull) >> 56);
+}
+
 // The largest of n keys.
 inline uint32_t maxKey(const uint32_t* keys, size_t n) {
   size_t i = 0;
@@ -66,7 +75,8 @@ inline uint32_t minKeyOf(DepthFormat format, const Plane& p, const double (&x)[3
     size = std::max(
         size, std::abs(p.v0) + std::abs(u) + std::abs(v) + std::abs(p.dx * x[i]) + std::abs(p.dy * y[i]));
   }
-  const double margin = std::ldexp(size, -45);
+  const double margin =
+      size * 0x1p-45;  // = ldexp(size, -45) (a power of two scales exactly), without the libm call
   if (!std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(margin)) return 0;
   return isReversed(format) ? depthKey(format, hi + margin) : depthKey(format, lo - margin);
 }

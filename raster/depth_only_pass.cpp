@@ -30,15 +30,6 @@ constexpr int B = kCoverageBlock;
 constexpr uint32_t kBias = 0x80000000u;
 constexpr int32_t kClearBiased = int32_t(kClearDepthKey ^ kBias);
 
-// Set bits of a block mask (no POPCNT in the x86-64 baseline; the
-// builtin would call libgcc).
-inline int bitCount(uint64_t m) {
-  m = m - ((m >> 1) & 0x5555555555555555ull);
-  m = (m & 0x3333333333333333ull) + ((m >> 2) & 0x3333333333333333ull);
-  m = (m + (m >> 4)) & 0x0F0F0F0F0F0F0F0Full;
-  return int((m * 0x0101010101010101ull) >> 56);
-}
-
 // What a row kernel needs of the triangle and the pass besides the row.
 struct RowContext {
   DepthFormat format;
@@ -288,6 +279,7 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
         typename Row::Acc acc = Row::start();
         int32_t narrowMax = INT32_MIN;
         uint32_t drawnRows = 0;  // a row with no covered texel is left as it is
+        uint64_t passes = 0;     // bit 8j + i: texel i of row j written
         for (int j = j0; j < j0 + b.h; ++j) {
           const uint32_t cover = uint32_t((mask >> (8 * (j - j0))) & 0xFFu) << shiftX;
           if (cover == 0) continue;
@@ -302,8 +294,9 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
             pass = testRowScalar(ctx, column, rowTerm, row, bw, cover, bx, by + j, &m);
             narrowMax = std::max(narrowMax, m);
           }
-          passed += uint64_t(bitCount(pass));
+          passes |= uint64_t(pass) << (8 * j);
         }
+        passed += uint64_t(bitCount(passes));
         // The block's exact largest key: the rows not drawn as well.
         for (int j = 0; j < bh; ++j) {
           if ((drawnRows >> j) & 1u) continue;

@@ -212,7 +212,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         uint32_t written = 0, writtenMax = 0;
         for (int s = 0; s < spp; ++s) {
           uint64_t m = masks[s];
-          counters->samplesTested += uint64_t(__builtin_popcountll(m));
+          counters->samplesTested += uint64_t(bitCount(m));
           while (m) {
             const int bit = __builtin_ctzll(m);
             m &= m - 1;
