@@ -45,6 +45,42 @@ Camera perspectiveLightCamera(const glm::dvec3& eye, const glm::dvec3& forward, 
 const glm::dvec3 kCubeAxes[kCubeFaces] = {glm::dvec3(1, 0, 0),  glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0),
                                           glm::dvec3(0, -1, 0), glm::dvec3(0, 0, 1),  glm::dvec3(0, 0, -1)};
 
+// A map's lookup constants (ShadowMaps::Lookup).
+ShadowMaps::Lookup lookupOf(const Camera& camera, const ClipSpace& space) {
+  ShadowMaps::Lookup k;
+  for (int c = 0; c < 4; ++c) k.column[c] = glm::dvec3(camera.viewFromWorld[c]);
+  k.scale = space.scale;
+  k.width = double(space.width);
+  k.height = double(space.height);
+  k.perspective = camera.projection == Projection::Perspective;
+  k.znear = camera.znear;
+  k.zfar = camera.zfar;
+  return k;
+}
+
+// Concatenates the tiles' sorted fragments in tile order and indexes
+// them by tile row (Map::attenuationRows).
+void indexAttenuation(const std::vector<std::vector<ShadowMaps::Attenuation>>& perTile,
+                      ShadowMaps::Map* map) {
+  size_t total = 0;
+  for (const auto& v : perTile) total += v.size();
+  map->attenuation.reserve(total);
+  map->attenuationRows.assign(perTile.size() * size_t(kTileSize) + 1, 0);
+  const size_t width = size_t(map->depth.width);
+  for (size_t tile = 0; tile < perTile.size(); ++tile) {
+    const size_t y0 = size_t(map->tiles.rect(int(tile)).y0);
+    uint32_t* rows = &map->attenuationRows[tile * size_t(kTileSize)];
+    size_t next = 0;  // the next row of the tile whose start is not yet set
+    for (const ShadowMaps::Attenuation& a : perTile[tile]) {
+      const size_t row = a.texel / width - y0;
+      for (; next <= row; ++next) rows[next] = uint32_t(map->attenuation.size());
+      map->attenuation.push_back(a);
+    }
+    for (; next < size_t(kTileSize); ++next) rows[next] = uint32_t(map->attenuation.size());
+  }
+  map->attenuationRows.back() = uint32_t(map->attenuation.size());
+}
+
 }  // namespace
 
 std::vector<Camera> cubeFaceCameras(const glm::dvec3& eye, int size, double znear) {
@@ -96,7 +132,8 @@ std::vector<uint8_t> cubeFaceCandidates(const Scene& scene, const glm::dvec3& ey
   return mask;
 }
 
-ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const Shader* shader)
+ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const Shader* shader,
+                       CoveragePath path)
     : scene_(scene) {
   const int size = options.shadowMapSize;
   glm::dvec3 centre(0.0);
@@ -131,7 +168,8 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
     for (size_t f = 0; f < cameras.size(); ++f) {
       const Camera& c = cameras[f];
       const SampleGrid grid = makeSampleGrid(1, size, size);
-      Map map{c, makeClipSpace(c, grid.guardPixels), DepthTarget(size, size, 1, true)};
+      Map map{c, makeClipSpace(c, grid.guardPixels), {}, DepthMap(size, size), TileGrid(size, size), {}, {}};
+      map.lookup = lookupOf(map.camera, map.space);
       if (cube && faces.empty()) faces = cubeFaceCandidates(scene, light.position, map.space.scale.x, size);
       DepthSettings ds{
           kMapFormat, c.projection, c.znear, c.zfar, options.shadowBiasSlope, options.shadowBiasConstant};
@@ -140,7 +178,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
       const std::vector<TriangleSetup> setups =
           prepareTriangles(scene, map.space, grid, ds, options.cull, filter, &counters);
       triangles_ += counters.trianglesIn;
-      const TileGrid tiles(size, size);
+      const TileGrid& tiles = map.tiles;
       // BLEND and refractive surfaces attenuate instead of blocking (with a
       // shader to ask how much); everything else writes depth.
       const auto transmissive = [&](const TriangleSetup& t) {
@@ -160,7 +198,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
       // the depth pass runs its lean path (no call per sample).
       const bool anyMask = std::any_of(scene.materials.begin(), scene.materials.end(),
                                        [](const Material& m) { return m.alphaMode == AlphaMode::Mask; });
-      std::function<bool(const TriangleSetup&, int, int, int)> alphaTest;
+      AlphaTestFunction alphaTest;
       if (shader && anyMask)
         alphaTest = [&](const TriangleSetup& t, int px, int py, int s) {
           const Material& m = scene.materialOf(t.instance);
@@ -172,9 +210,10 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         if (interruptRequested()) return;  // Ctrl-C: thrown below
         DepthPassCounters dc;
         const TileRect rect = tiles.rect(tile);
-        rasterDepthPass(setups, bins[size_t(tile)], grid, rect, kMapFormat, DepthFunc::Less, alphaTest,
-                        TraceRequest{}, &map.depth, &dc);
+        DepthOnlyTile depth(rect);
+        depth.render(setups, bins[size_t(tile)], grid, kMapFormat, alphaTest, &dc, path);
         // Attenuating fragments in front of the opaque depth, kept per texel.
+        std::vector<Attenuation>& found = perTile[size_t(tile)];
         CoverageScratch scratch;
         for (uint32_t index : transmissiveBins[size_t(tile)]) {
           const TriangleSetup& t = setups[index];
@@ -186,20 +225,21 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
           any.material = &m;
           const glm::vec3 uniform = constant ? shader->shadowTransmittance(any) : glm::vec3(1.0f);
           forEachCoveredSample(t, grid, rect, scratch, [&](int px, int py, int s) {
-            const size_t texel = map.depth.index(px, py, 0);
+            const size_t texel = map.depth.index(px, py);
             const uint32_t key = sampleDepthKey(t, grid, kMapFormat, px, py, s);
-            if (key >= map.depth.keys[texel]) return;
+            if (key >= depth.key(px, py)) return;
             const glm::vec3 pass = constant ? uniform : shader->shadowTransmittance(surfaceAt(t, px, py, s));
-            perTile[size_t(tile)].push_back({uint32_t(texel), key, pass});
+            found.push_back({uint32_t(texel), key, pass});
           });
         }
+        depth.store(&map.depth);
+        // By (texel, key); stable: equal keys keep the order met.
+        std::stable_sort(found.begin(), found.end(), [](const Attenuation& a, const Attenuation& b) {
+          return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
+        });
       });
       throwIfInterrupted();
-      for (const auto& v : perTile) map.attenuation.insert(map.attenuation.end(), v.begin(), v.end());
-      std::sort(map.attenuation.begin(), map.attenuation.end(),
-                [](const Attenuation& a, const Attenuation& b) {
-                  return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
-                });
+      indexAttenuation(perTile, &map);
       attenuating_ += map.attenuation.size();
       perLight_[l].push_back(std::move(map));
     }
@@ -208,7 +248,9 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
     for (const Map& m : maps) maps_.push_back(&m);
 }
 
-glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world) const {
+// The reference lookup: project with the general functions, then binary
+// search the tile's fragments for the texel.
+glm::vec3 ShadowMaps::litReference(const Map& map, const glm::dvec3& world) const {
   const glm::dvec3 view(map.camera.viewFromWorld * glm::dvec4(world, 1.0));
   const ClipVertex v = map.space.project(view, glm::dvec3(0.0));
   const glm::vec3 one(1.0f);
@@ -219,21 +261,66 @@ glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world) const {
   const double z =
       windowDepth(kMapFormat, map.camera.projection, map.camera.znear, map.camera.zfar, v.position.z);
   const uint32_t key = depthKey(kMapFormat, z);
-  const uint32_t texel = uint32_t(map.depth.index(x, y, 0));
+  const uint32_t texel = uint32_t(map.depth.index(x, y));
   if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
   // Attenuation by the transmissive layers between the light and the point.
+  const size_t tile = size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize);
+  const auto first = map.attenuation.begin() + map.attenuationRows[tile * kTileSize];
+  const auto last = map.attenuation.begin() + map.attenuationRows[(tile + 1) * kTileSize];
   glm::vec3 t = one;
-  auto it = std::lower_bound(map.attenuation.begin(), map.attenuation.end(), texel,
-                             [](const Attenuation& a, uint32_t tx) { return a.texel < tx; });
-  for (; it != map.attenuation.end() && it->texel == texel && it->key < key; ++it) t *= it->transmittance;
+  auto it =
+      std::lower_bound(first, last, texel, [](const Attenuation& a, uint32_t tx) { return a.texel < tx; });
+  for (; it != last && it->texel == texel && it->key < key; ++it) t *= it->transmittance;
   return t;
 }
 
-glm::vec3 ShadowMaps::transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
-                                    double) const {
+// The same operations as litReference, in the same order (so the same
+// bits): glm's matrix product is (c0·x + c1·y) + (c2·z + c3·1) per row,
+// ClipSpace::project and imageOf, and the reversed window depth formula of
+// common/depth_formula.cpp; only the calls, the unused fourth row and the
+// search over the whole tile are gone.
+glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world) const {
+  static_assert(kMapFormat == DepthFormat::FloatReversed, "lit() inlines the reversed window depth");
+  const Lookup& k = map.lookup;
+  const glm::dvec3 view =
+      (k.column[0] * world.x + k.column[1] * world.y) + (k.column[2] * world.z + k.column[3]);
+  const double d = -view.z;
+  const double w = k.perspective ? d : 1.0;
+  const glm::vec3 one(1.0f);
+  if (!(d > k.znear) || w <= 0.0) return one;  // behind the map: unshadowed
+  const double ix = (view.x / k.scale.x / w + 1.0) * 0.5 * k.width;
+  const double iy = (1.0 - view.y / k.scale.y / w) * 0.5 * k.height;
+  const int x = int(std::floor(ix)), y = int(std::floor(iy));
+  if (x < 0 || y < 0 || x >= map.depth.width || y >= map.depth.height) return one;
+  double z;  // reversedWindowDepth
+  if (!k.perspective)
+    z = (k.zfar - d) / (k.zfar - k.znear);
+  else if (std::isinf(k.zfar))
+    z = k.znear / d;
+  else
+    z = k.znear * (k.zfar - d) / (d * (k.zfar - k.znear));
+  const uint32_t key = depthKey(kMapFormat, z);
+  const uint32_t texel = uint32_t(map.depth.index(x, y));
+  if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
+  // Attenuation by the transmissive layers between the light and the point:
+  // only the fragments of the texel's row within its tile are searched.
+  const size_t slot = (size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize)) * kTileSize +
+                      size_t(y % kTileSize);
+  const uint32_t first = map.attenuationRows[slot], last = map.attenuationRows[slot + 1];
+  glm::vec3 t = one;
+  if (first == last) return t;
+  const Attenuation* a = map.attenuation.data();
+  const Attenuation* it = std::lower_bound(a + first, a + last, texel,
+                                           [](const Attenuation& f, uint32_t tx) { return f.texel < tx; });
+  for (; it != a + last && it->texel == texel && it->key < key; ++it) t *= it->transmittance;
+  return t;
+}
+
+const ShadowMaps::Map& ShadowMaps::mapAt(size_t i) const { return *maps_.at(i); }
+
+const ShadowMaps::Map& ShadowMaps::mapFor(int lightIndex, const glm::dvec3& toLight) const {
   const std::vector<Map>& maps = perLight_[size_t(lightIndex)];
-  if (maps.empty()) return glm::vec3(1.0f);
-  if (maps.size() == 1) return lit(maps[0], point.position);
+  if (maps.size() == 1) return maps[0];
   // Cube map: the face of the major axis of the direction from the light.
   const glm::dvec3 d = -toLight;
   const glm::dvec3 a = glm::abs(d);
@@ -244,7 +331,33 @@ glm::vec3 ShadowMaps::transmittance(const SurfacePoint& point, int lightIndex, c
     face = d.y > 0 ? 2 : 3;
   else
     face = d.z > 0 ? 4 : 5;
-  return lit(maps[size_t(face)], point.position);
+  return maps[size_t(face)];
+}
+
+glm::vec3 ShadowMaps::lightTransmittance(int lightIndex, const glm::dvec3& world,
+                                         const glm::dvec3& toLight) const {
+  if (perLight_[size_t(lightIndex)].empty()) return glm::vec3(1.0f);
+  return lit(mapFor(lightIndex, toLight), world);
+}
+
+void ShadowMaps::lightTransmittances(int lightIndex, size_t n, const glm::dvec3* world,
+                                     const glm::dvec3* toLight, glm::vec3* out) const {
+  if (perLight_[size_t(lightIndex)].empty()) {
+    std::fill_n(out, n, glm::vec3(1.0f));
+    return;
+  }
+  for (size_t i = 0; i < n; ++i) out[i] = lit(mapFor(lightIndex, toLight[i]), world[i]);
+}
+
+glm::vec3 ShadowMaps::lightTransmittanceReference(int lightIndex, const glm::dvec3& world,
+                                                  const glm::dvec3& toLight) const {
+  if (perLight_[size_t(lightIndex)].empty()) return glm::vec3(1.0f);
+  return litReference(mapFor(lightIndex, toLight), world);
+}
+
+glm::vec3 ShadowMaps::transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
+                                    double) const {
+  return lightTransmittance(lightIndex, point.position, toLight);
 }
 
 }  // namespace rastray

@@ -17,6 +17,15 @@
 // in front of its opaque depth (a small deep shadow map), and a lookup
 // multiplies those nearer to the light than the point. Without a shader
 // they block like opaque surfaces.
+//
+// Speed. The opaque depth runs the depth-only pass (depth_only_pass.h:
+// the camera pass's block coverage and hierarchical depth, SIMD keys, a
+// tile-local buffer streamed into the map), with the same keys as the
+// camera pass's keys-only rasterDepthPass. A lookup costs a few double
+// operations (the reference's, inlined: same bits) and one load from the
+// map, which at 2048² misses the caches for most shaded samples; the
+// transmissive fragments are indexed by tile row, so a texel without any
+// costs one more load and no search.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +35,9 @@
 #include "common/camera.h"
 #include "common/scene.h"
 #include "common/shading.h"
+#include "raster/bin.h"
 #include "raster/coverage.h"
+#include "raster/depth_only_pass.h"
 #include "raster/options.h"
 
 namespace rastray {
@@ -46,10 +57,27 @@ class ShadowMaps : public LightVisibility {
  public:
   // Renders the maps of every light (none without lights). `shader`
   // decides MASK coverage and transmittance (null: both cast as OPAQUE).
-  ShadowMaps(const Scene& scene, const RasterOptions& options, const Shader* shader);
+  // `path` picks the depth-only pass's walk (identical maps; Reference
+  // for the tests that prove it).
+  ShadowMaps(const Scene& scene, const RasterOptions& options, const Shader* shader,
+             CoveragePath path = CoveragePath::Fast);
 
   glm::vec3 transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
                           double distance) const override;
+
+  // The transmittance of light `lightIndex` at `world`, `toLight` the
+  // direction from the point towards the light (it picks the cube face):
+  // what transmittance() returns for a point at `world`. Plain members,
+  // not virtual, for callers that shade many points at once: the batch
+  // form looks up n points of one light.
+  glm::vec3 lightTransmittance(int lightIndex, const glm::dvec3& world, const glm::dvec3& toLight) const;
+  void lightTransmittances(int lightIndex, size_t n, const glm::dvec3* world, const glm::dvec3* toLight,
+                           glm::vec3* out) const;
+  // The same from the scalar reference lookup: the general matrix and
+  // window-depth functions, and a binary search of the map tile's
+  // attenuating fragments. The tests demand the same bits.
+  glm::vec3 lightTransmittanceReference(int lightIndex, const glm::dvec3& world,
+                                        const glm::dvec3& toLight) const;
 
   uint64_t trianglesRendered() const { return triangles_; }
   uint64_t mapCount() const { return maps_.size(); }
@@ -61,15 +89,39 @@ class ShadowMaps : public LightVisibility {
     uint32_t key;  // depth key from the light, bias applied
     glm::vec3 transmittance;
   };
+  // What a lookup needs of a map, precomputed: the view matrix's x, y and
+  // z rows (glm's column order of operations kept, so the view position
+  // has the bits of viewFromWorld · (world, 1)), the clip scale and the
+  // window-depth constants.
+  struct Lookup {
+    glm::dvec3 column[4];  // (x, y, z) rows of viewFromWorld's columns
+    glm::dvec2 scale;
+    double width = 0.0, height = 0.0;
+    bool perspective = true;
+    double znear = 0.0, zfar = 0.0;
+  };
   struct Map {
     Camera camera;
     ClipSpace space;
-    DepthTarget depth;
-    std::vector<Attenuation> attenuation;  // sorted by (texel, key)
+    Lookup lookup;
+    DepthMap depth;
+    TileGrid tiles{0, 0};
+    // The transmissive fragments in front of the opaque depth: by tile,
+    // then (texel, key); equal keys at a texel in the order the pass met
+    // them (bin order, then texel order).
+    std::vector<Attenuation> attenuation;
+    // Per tile and row within it (tile · kTileSize + row): the first
+    // fragment of that row of the tile; one more entry ends the last tile.
+    std::vector<uint32_t> attenuationRows;
   };
+
+  // Map i, lights in order (a point light's six faces in face order).
+  const Map& mapAt(size_t i) const;
 
  private:
   glm::vec3 lit(const Map& map, const glm::dvec3& world) const;
+  glm::vec3 litReference(const Map& map, const glm::dvec3& world) const;
+  const Map& mapFor(int lightIndex, const glm::dvec3& toLight) const;
 
   const Scene& scene_;
   std::vector<std::vector<Map>> perLight_;  // by light index; 6 faces for point lights

@@ -1,0 +1,436 @@
+#include "raster/depth_only_pass.h"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+#include "common/error.h"
+#include "raster/depth_bounds.h"
+#include "raster/depth_keys.h"
+
+namespace rastray {
+
+namespace {
+
+constexpr int B = kCoverageBlock;
+
+// The local buffer holds biased keys, key ^ 2^31 as int32, so that SSE2's
+// signed compares order them as the unsigned keys (SSE2 has no unsigned
+// compare nor 32-bit max).
+constexpr uint32_t kBias = 0x80000000u;
+constexpr int32_t kClearBiased = int32_t(kClearDepthKey ^ kBias);
+
+// What a row kernel needs of the triangle and the pass besides the row.
+struct RowContext {
+  DepthFormat format;
+  const AlphaTestFunction& alphaTest;
+  const TriangleSetup& t;
+  DepthPassCounters* counters;
+  // The MASK test of the lanes in `pass` of row py from column px0 (bit i:
+  // texel px0 + i); returns the lanes that stay covered.
+  uint32_t alpha(uint32_t pass, int px0, int py) const {
+    for (uint32_t m = pass; m; m &= m - 1) {
+      const int i = __builtin_ctz(m);
+      if (!alphaTest(t, px0 + i, py, 0)) {
+        pass &= ~(1u << i);
+        ++counters->alphaRejected;
+      }
+    }
+    return pass;
+  }
+};
+
+// The test and write of one block row, the scalar form (rows narrower than
+// a block, builds without SSE2): lanes i < width of `row` (biased keys),
+// covered lanes `cover`. Returns the lanes written; `rowMax` receives the
+// largest biased key the row holds afterwards.
+inline uint32_t testRowScalar(const RowContext& ctx, const double (&column)[8], double rowTerm, int32_t* row,
+                              int width, uint32_t cover, int px0, int py, int32_t* rowMax) {
+  uint32_t keys[8];
+  planeRowKeys(ctx.format, column, rowTerm, keys);
+  uint32_t pass = 0;
+  for (int i = 0; i < width; ++i)
+    if (((cover >> i) & 1u) && int32_t(keys[i] ^ kBias) < row[i]) pass |= 1u << i;
+  if (pass && ctx.alphaTest) pass = ctx.alpha(pass, px0, py);
+  int32_t m = INT32_MIN;
+  for (int i = 0; i < width; ++i) {
+    if ((pass >> i) & 1u) row[i] = int32_t(keys[i] ^ kBias);
+    m = std::max(m, row[i]);
+  }
+  *rowMax = m;
+  return pass;
+}
+
+#if defined(__SSE2__)
+// Eight texels of a row in two SSE2 registers.
+struct Sse2Row {
+  using Acc = __m128i;
+  static __m128i select(__m128i mask, __m128i a, __m128i b) {
+    return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b));
+  }
+  static void laneMasks(uint32_t bits, __m128i& lo, __m128i& hi) {
+    const __m128i v = _mm_set1_epi32(int32_t(bits));
+    const __m128i l = _mm_setr_epi32(1, 2, 4, 8), h = _mm_setr_epi32(16, 32, 64, 128);
+    lo = _mm_cmpeq_epi32(_mm_and_si128(v, l), l);
+    hi = _mm_cmpeq_epi32(_mm_and_si128(v, h), h);
+  }
+  static __m128i maxI32(__m128i a, __m128i b) { return select(_mm_cmpgt_epi32(a, b), a, b); }
+
+  // A full row of eight texels (testRowScalar's contract); `acc` gathers
+  // the largest biased key written or kept.
+  uint32_t operator()(const RowContext& ctx, const double (&column)[8], double rowTerm, int32_t* row,
+                      uint32_t cover, int px0, int py, __m128i& acc) const {
+    __m128i klo, khi;
+    if (ctx.format == DepthFormat::FloatReversed || ctx.format == DepthFormat::Float) {
+      floatRowKeys(ctx.format == DepthFormat::FloatReversed, column, rowTerm, klo, khi);
+    } else {
+      alignas(16) uint32_t k[8];
+      planeRowKeys(ctx.format, column, rowTerm, k);
+      klo = _mm_load_si128(reinterpret_cast<const __m128i*>(k));
+      khi = _mm_load_si128(reinterpret_cast<const __m128i*>(k + 4));
+    }
+    const __m128i bias = _mm_set1_epi32(int32_t(kBias));
+    klo = _mm_xor_si128(klo, bias);
+    khi = _mm_xor_si128(khi, bias);
+    const __m128i slo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
+    const __m128i shi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 4));
+    __m128i plo = _mm_cmplt_epi32(klo, slo), phi = _mm_cmplt_epi32(khi, shi);
+    if (cover != 0xFFu) {
+      __m128i clo, chi;
+      laneMasks(cover, clo, chi);
+      plo = _mm_and_si128(plo, clo);
+      phi = _mm_and_si128(phi, chi);
+    }
+    uint32_t pass = uint32_t(_mm_movemask_ps(_mm_castsi128_ps(plo))) |
+                    (uint32_t(_mm_movemask_ps(_mm_castsi128_ps(phi))) << 4);
+    if (pass && ctx.alphaTest) {
+      const uint32_t kept = ctx.alpha(pass, px0, py);
+      if (kept != pass) laneMasks(kept, plo, phi);
+      pass = kept;
+    }
+    const __m128i nlo = select(plo, klo, slo), nhi = select(phi, khi, shi);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(row), nlo);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(row + 4), nhi);
+    acc = maxI32(acc, maxI32(nlo, nhi));
+    return pass;
+  }
+  static __m128i start() { return _mm_set1_epi32(INT32_MIN); }
+  // Gathers the keys of a row the triangle did not draw.
+  static void fold(const int32_t* row, __m128i& acc) {
+    acc = maxI32(acc, maxI32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(row)),
+                             _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 4))));
+  }
+  static int32_t reduce(__m128i acc) {
+    acc = maxI32(acc, _mm_shuffle_epi32(acc, _MM_SHUFFLE(1, 0, 3, 2)));
+    acc = maxI32(acc, _mm_shuffle_epi32(acc, _MM_SHUFFLE(2, 3, 0, 1)));
+    return _mm_cvtsi128_si32(acc);
+  }
+  static int passCount(uint32_t pass) { return bitCount(pass); }
+};
+#endif
+
+// The same without SSE2: every row through testRowScalar.
+struct ScalarRow {
+  using Acc = int32_t;
+  static Acc start() { return INT32_MIN; }
+  static int32_t reduce(Acc acc) { return acc; }
+  static void fold(const int32_t* row, Acc& acc) { acc = std::max(acc, *std::max_element(row, row + B)); }
+  uint32_t operator()(const RowContext& ctx, const double (&column)[8], double rowTerm, int32_t* row,
+                      uint32_t cover, int px0, int py, Acc& acc) const {
+    int32_t m;
+    const uint32_t pass = testRowScalar(ctx, column, rowTerm, row, B, cover, px0, py, &m);
+    acc = std::max(acc, m);
+    return pass;
+  }
+};
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define RASTRAY_DEPTH_ONLY_AVX2 1
+// Eight texels in one AVX2 register, chosen at run time: the double
+// arithmetic in four-wide vectors with the SSE2 kernel's operations and
+// operand order (VMAXPD/VMINPD/VCVTPD2PS behave as their SSE forms), so
+// the same bits. target("avx2") enables no FMA, so nothing is contracted.
+struct Avx2Row {
+  using Acc = __m256i;
+  __attribute__((target("avx2"))) static Acc start() { return _mm256_set1_epi32(INT32_MIN); }
+  __attribute__((target("avx2"))) static int32_t reduce(Acc acc) {
+    __m128i m = _mm_max_epi32(_mm256_castsi256_si128(acc), _mm256_extracti128_si256(acc, 1));
+    m = _mm_max_epi32(m, _mm_shuffle_epi32(m, _MM_SHUFFLE(1, 0, 3, 2)));
+    m = _mm_max_epi32(m, _mm_shuffle_epi32(m, _MM_SHUFFLE(2, 3, 0, 1)));
+    return _mm_cvtsi128_si32(m);
+  }
+  __attribute__((target("avx2"))) static void fold(const int32_t* row, Acc& acc) {
+    acc = _mm256_max_epi32(acc, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row)));
+  }
+  __attribute__((target("avx2"))) static __m256i laneMask(uint32_t bits) {
+    const __m256i l = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int32_t(bits)), l), l);
+  }
+  __attribute__((target("avx2"))) uint32_t operator()(const RowContext& ctx, const double (&column)[8],
+                                                      double rowTerm, int32_t* row, uint32_t cover, int px0,
+                                                      int py, Acc& acc) const {
+    __m256i k;
+    if (ctx.format == DepthFormat::FloatReversed || ctx.format == DepthFormat::Float) {
+      const __m256d r = _mm256_set1_pd(rowTerm), zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+      const __m256d z0 = _mm256_add_pd(_mm256_loadu_pd(column), r);
+      const __m256d z1 = _mm256_add_pd(_mm256_loadu_pd(column + 4), r);
+      const __m128 f0 = _mm256_cvtpd_ps(_mm256_min_pd(one, _mm256_max_pd(zero, z0)));
+      const __m128 f1 = _mm256_cvtpd_ps(_mm256_min_pd(one, _mm256_max_pd(zero, z1)));
+      const __m256i bits = _mm256_castps_si256(_mm256_insertf128_ps(_mm256_castps128_ps256(f0), f1, 1));
+      // Biased reversed key: (0x3F800000 − bits) ^ 2^31 = 0xBF800000 − bits (mod 2^32).
+      k = ctx.format == DepthFormat::FloatReversed
+              ? _mm256_sub_epi32(_mm256_set1_epi32(int32_t(0xBF800000u)), bits)
+              : _mm256_xor_si256(bits, _mm256_set1_epi32(int32_t(kBias)));
+    } else {
+      alignas(32) uint32_t keys[8];
+      planeRowKeys(ctx.format, column, rowTerm, keys);
+      k = _mm256_xor_si256(_mm256_load_si256(reinterpret_cast<const __m256i*>(keys)),
+                           _mm256_set1_epi32(int32_t(kBias)));
+    }
+    const __m256i stored = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row));
+    __m256i p = _mm256_cmpgt_epi32(stored, k);
+    if (cover != 0xFFu) p = _mm256_and_si256(p, laneMask(cover));
+    uint32_t pass = uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(p)));
+    if (pass && ctx.alphaTest) {
+      const uint32_t kept = ctx.alpha(pass, px0, py);
+      if (kept != pass) p = laneMask(kept);
+      pass = kept;
+    }
+    const __m256i n = _mm256_blendv_epi8(stored, k, p);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(row), n);
+    acc = _mm256_max_epi32(acc, n);
+    return pass;
+  }
+};
+#endif
+
+// drawFast<Avx2Row> passes AVX vectors between functions compiled without
+// AVX, which GCC warns changes the ABI; it is always inlined into drawAvx2
+// (AVX2), so no such call exists.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+// The fast walk of the bin over the tile's buffer `keys` (biased, rows of
+// kTileSize), rows of full blocks through `kernel`. Inlined into each
+// kernel's entry point, so that its ISA covers the whole loop.
+template <typename Row>
+__attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRect& rect,
+                                                    const std::vector<TriangleSetup>& setups,
+                                                    const std::vector<uint32_t>& bin, const SampleGrid& grid,
+                                                    DepthFormat format, const AlphaTestFunction& alphaTest,
+                                                    DepthPassCounters* counters, const Row& kernel) {
+  const int width = rect.x1 - rect.x0, height = rect.y1 - rect.y0;
+  const int columns = (width + B - 1) / B;
+  const size_t blocks = size_t(columns) * size_t((height + B - 1) / B);
+  // Per block of the rect: the largest key stored (unbiased), exact: the
+  // kernels write whole rows, so they see every key of the rows they draw,
+  // and the block's other rows are read back (from the cache-resident
+  // buffer) after each triangle that draws some.
+  uint32_t blockMax[(kTileSize / B) * (kTileSize / B)];
+  std::fill_n(blockMax, blocks, kClearDepthKey);
+  const glm::dvec2 pos = grid.positions[0];
+  const int64_t U = grid.unitsPerPixel;
+  CoverageScratch scratch;
+  uint64_t mask = 0;
+  uint64_t tested = 0, passed = 0;
+
+  for (uint32_t index : bin) {
+    const TriangleSetup& t = setups[index];
+    const PixelBounds r = boundsIn(t, rect);
+    if (r.empty()) continue;
+    counters->coverageTests += r.samples(1);
+    prepareOffsets(t, grid, scratch);
+    const uint32_t triangleKey = minKeyOverTriangle(t, format, U);
+    const RowContext ctx{format, alphaTest, t, counters};
+    for (int by = rect.y0 + (r.y0 - rect.y0) / B * B; by <= r.y1; by += B)
+      for (int bx = rect.x0 + (r.x0 - rect.x0) / B * B; bx <= r.x1; bx += B) {
+        const int cx0 = std::max(bx, r.x0), cy0 = std::max(by, r.y0);
+        const PixelBlock b{cx0, cy0, std::min(bx + B - 1, r.x1) - cx0 + 1,
+                           std::min(by + B - 1, r.y1) - cy0 + 1};
+        int64_t lo[3];
+        const BlockClass c = classifyBlock(t, scratch, U, b, lo);
+        if (c == BlockClass::Reject) continue;
+        const size_t hb = size_t((by - rect.y0) / B) * size_t(columns) + size_t((bx - rect.x0) / B);
+        // Hierarchical test: behind every stored key of the block.
+        if (blockMax[hb] != kClearDepthKey &&
+            std::max(triangleKey, minKeyOverBlock(t, format, b, pos, pos)) > blockMax[hb])
+          continue;
+        if (c == BlockClass::Accept)
+          mask = fullBlockMask(b);
+        else
+          blockMasks(t, scratch, U, 1, b, lo, &mask);
+        if (mask == 0) continue;
+        tested += uint64_t(bitCount(mask));
+        // The block of the rect: bw × bh texels at (bx, by); t's block b
+        // starts shiftX columns and j0 rows into it.
+        const int bw = std::min(B, rect.x1 - bx), bh = std::min(B, rect.y1 - by);
+        const int shiftX = b.x - bx, j0 = b.y - by;
+        double column[8];
+        planeColumnTerms(t.depth, bx, pos.x, column);
+        typename Row::Acc acc = Row::start();
+        int32_t narrowMax = INT32_MIN;
+        uint32_t drawnRows = 0;  // a row with no covered texel is left as it is
+        uint64_t passes = 0;     // bit 8j + i: texel i of row j written
+        for (int j = j0; j < j0 + b.h; ++j) {
+          const uint32_t cover = uint32_t((mask >> (8 * (j - j0))) & 0xFFu) << shiftX;
+          if (cover == 0) continue;
+          drawnRows |= 1u << j;
+          int32_t* row = keys + size_t(by + j - rect.y0) * kTileSize + size_t(bx - rect.x0);
+          const double rowTerm = planeRowTerm(t.depth, by + j, pos.y);
+          uint32_t pass;
+          if (bw == B) {
+            pass = kernel(ctx, column, rowTerm, row, cover, bx, by + j, acc);
+          } else {
+            int32_t m;
+            pass = testRowScalar(ctx, column, rowTerm, row, bw, cover, bx, by + j, &m);
+            narrowMax = std::max(narrowMax, m);
+          }
+          passes |= uint64_t(pass) << (8 * j);
+        }
+        passed += uint64_t(bitCount(passes));
+        // The block's exact largest key: the rows not drawn as well.
+        for (int j = 0; j < bh; ++j) {
+          if ((drawnRows >> j) & 1u) continue;
+          const int32_t* row = keys + size_t(by + j - rect.y0) * kTileSize + size_t(bx - rect.x0);
+          if (bw == B)
+            Row::fold(row, acc);
+          else
+            narrowMax = std::max(narrowMax, *std::max_element(row, row + bw));
+        }
+        blockMax[hb] = uint32_t(std::max(Row::reduce(acc), narrowMax)) ^ kBias;
+      }
+  }
+  counters->samplesTested += tested;
+  counters->samplesPassed += passed;
+}
+
+#pragma GCC diagnostic pop
+
+#if defined(__SSE2__)
+void drawSse2(int32_t* keys, const TileRect& rect, const std::vector<TriangleSetup>& setups,
+              const std::vector<uint32_t>& bin, const SampleGrid& grid, DepthFormat format,
+              const AlphaTestFunction& alphaTest, DepthPassCounters* counters) {
+  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Sse2Row{});
+}
+#endif
+
+#if defined(RASTRAY_DEPTH_ONLY_AVX2)
+__attribute__((target("avx2"))) void drawAvx2(int32_t* keys, const TileRect& rect,
+                                              const std::vector<TriangleSetup>& setups,
+                                              const std::vector<uint32_t>& bin, const SampleGrid& grid,
+                                              DepthFormat format, const AlphaTestFunction& alphaTest,
+                                              DepthPassCounters* counters) {
+  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Avx2Row{});
+}
+
+bool hasAvx2() {
+  static const bool yes = __builtin_cpu_supports("avx2");
+  return yes;
+}
+#endif
+
+}  // namespace
+
+DepthMap::DepthMap(int w, int h) : width(w), height(h) {
+  // Whole 2 MB pages (the huge-page size) and at least cache-line aligned.
+  constexpr size_t kPage = size_t(2) << 20;
+  const size_t bytes = std::max<size_t>(size_t(w) * size_t(h) * sizeof(uint32_t), 1);
+  const size_t align = bytes >= kPage ? kPage : 64;
+  void* p = std::aligned_alloc(align, (bytes + align - 1) / align * align);
+  if (!p) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  if (align == kPage) madvise(p, (bytes + align - 1) / align * align, MADV_HUGEPAGE);  // advice only
+#endif
+  keys.reset(static_cast<uint32_t*>(p));
+}
+
+DepthOnlyTile::DepthOnlyTile(const TileRect& rect) : rect_(rect) {
+  RASTRAY_CHECK(rect.x1 - rect.x0 <= kTileSize && rect.y1 - rect.y0 <= kTileSize && rect.x0 <= rect.x1 &&
+                    rect.y0 <= rect.y1,
+                "a depth-only tile is at most " + std::to_string(kTileSize) + " texels square");
+}
+
+void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
+                           const SampleGrid& grid, DepthFormat format, const AlphaTestFunction& alphaTest,
+                           DepthPassCounters* counters, CoveragePath path, SimdLevel simd) {
+  RASTRAY_CHECK(grid.spp == 1,
+                "the depth-only pass takes 1 sample per texel, not " + std::to_string(grid.spp));
+  const TileRect& rect = rect_;
+  const int width = rect.x1 - rect.x0, height = rect.y1 - rect.y0;
+  for (int j = 0; j < height; ++j) std::fill_n(&keys_[size_t(j) * kTileSize], size_t(width), kClearBiased);
+  if (path == CoveragePath::Reference) {
+    CoverageScratch scratch;
+    for (uint32_t index : bin) {
+      const TriangleSetup& t = setups[index];
+      counters->coverageTests +=
+          forEachCoveredSampleReference(t, grid, rect, scratch, [&](int px, int py, int s) {
+            ++counters->samplesTested;
+            int32_t& stored = keys_[size_t(py - rect.y0) * kTileSize + size_t(px - rect.x0)];
+            const uint32_t key = sampleDepthKey(t, grid, format, px, py, s);
+            if (!(key < (uint32_t(stored) ^ kBias))) return;  // keys only: a tie keeps the stored key
+            if (alphaTest && !alphaTest(t, px, py, s)) {
+              ++counters->alphaRejected;
+              return;
+            }
+            ++counters->samplesPassed;
+            stored = int32_t(key ^ kBias);
+          });
+    }
+    return;
+  }
+#if defined(RASTRAY_DEPTH_ONLY_AVX2)
+  if (simd == SimdLevel::Best && hasAvx2()) {
+    drawAvx2(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+    return;
+  }
+#endif
+  (void)simd;
+#if defined(__SSE2__)
+  drawSse2(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+#else
+  drawFast(keys_, rect, setups, bin, grid, format, alphaTest, counters, ScalarRow{});
+#endif
+}
+
+void DepthOnlyTile::store(DepthMap* map) const {
+  const int width = rect_.x1 - rect_.x0;
+  for (int y = rect_.y0; y < rect_.y1; ++y) {
+    const int32_t* src = &keys_[size_t(y - rect_.y0) * kTileSize];
+    uint32_t* dst = &map->keys[map->index(rect_.x0, y)];
+    int i = 0;
+#if defined(__SSE2__)
+    // Streaming stores need 16-byte aligned destinations: the maps' rows
+    // are whenever the width is a multiple of 4 (tiles start at multiples
+    // of 64 texels).
+    const __m128i bias = _mm_set1_epi32(int32_t(kBias));
+    if ((reinterpret_cast<uintptr_t>(dst) & 15) == 0)
+      for (; i + 4 <= width; i += 4)
+        _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i),
+                         _mm_xor_si128(_mm_load_si128(reinterpret_cast<const __m128i*>(src + i)), bias));
+#endif
+    for (; i < width; ++i) dst[i] = uint32_t(src[i]) ^ kBias;
+  }
+#if defined(__SSE2__)
+  _mm_sfence();  // streaming stores are weakly ordered: publish them before the task completes
+#endif
+}
+
+void rasterDepthOnlyPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
+                         const SampleGrid& grid, const TileRect& rect, DepthFormat format,
+                         const AlphaTestFunction& alphaTest, DepthMap* map, DepthPassCounters* counters,
+                         CoveragePath path, SimdLevel simd) {
+  DepthOnlyTile tile(rect);
+  tile.render(setups, bin, grid, format, alphaTest, counters, path, simd);
+  tile.store(map);
+}
+
+}  // namespace rastray
