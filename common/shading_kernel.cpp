@@ -337,31 +337,29 @@ class BlockShader {
     const size_t i = block_.used++;
     LaneBlock& b = block_;
     outputs_[i] = out;
-    const Instance& inst = scene_.instances[h.instance];
-    const glm::uvec3 t = scene_.triangle(h.instance, h.triangle);
+    // Consecutive hits mostly share a triangle: its data is looked up once
+    // per run (the same values, so the lane does not depend on the run).
+    if (h.instance != run_.instance || h.triangle != run_.triangle) startRun(h.instance, h.triangle);
+    const Instance& inst = *run_.inst;
+    const glm::uvec3 t = run_.corners;
     const double b0 = 1.0 - double(h.b1) - double(h.b2);
-    // The face normal and the side in double, as makeSurfacePoint and
-    // Shader::shade decide them.
-    const glm::dvec3 ng = triangleFaceNormal(scene_, h.instance, h.triangle);
-    const bool entering = isEntering(h.direction, ng);
+    // The side in double, from the face normal in double, as
+    // makeSurfacePoint and Shader::shade decide it.
+    const bool entering = isEntering(h.direction, run_.ng);
     b.side[i] = entering ? 1.0f : -1.0f;
-    b.ngX[i] = float(ng.x);
-    b.ngY[i] = float(ng.y);
-    b.ngZ[i] = float(ng.z);
+    b.ngX[i] = run_.ngF.x;
+    b.ngY[i] = run_.ngF.y;
+    b.ngZ[i] = run_.ngF.z;
     b.dirX[i] = float(h.direction.x);
     b.dirY[i] = float(h.direction.y);
     b.dirZ[i] = float(h.direction.z);
     b.b0[i] = float(b0);
     b.b1[i] = h.b1;
     b.b2[i] = h.b2;
-    const bool authored = inst.normals == NormalSource::Authored;
-    b.authored[i] = authored ? 1.0f : 0.0f;
-    const glm::vec3 n0 = authored ? scene_.normals[t.x] : glm::vec3(0.0f);
-    const glm::vec3 n1 = authored ? scene_.normals[t.y] : glm::vec3(0.0f);
-    const glm::vec3 n2 = authored ? scene_.normals[t.z] : glm::vec3(0.0f);
-    b.n0X[i] = n0.x, b.n0Y[i] = n0.y, b.n0Z[i] = n0.z;
-    b.n1X[i] = n1.x, b.n1Y[i] = n1.y, b.n1Z[i] = n1.z;
-    b.n2X[i] = n2.x, b.n2Y[i] = n2.y, b.n2Z[i] = n2.z;
+    b.authored[i] = run_.authored ? 1.0f : 0.0f;
+    b.n0X[i] = run_.n0.x, b.n0Y[i] = run_.n0.y, b.n0Z[i] = run_.n0.z;
+    b.n1X[i] = run_.n1.x, b.n1Y[i] = run_.n1.y, b.n1Z[i] = run_.n1.z;
+    b.n2X[i] = run_.n2.x, b.n2Y[i] = run_.n2.y, b.n2Z[i] = run_.n2.z;
 
     // Base colour and emission: Shader::baseColor and emission's float
     // steps, here with the textures sampled through the pixel footprint.
@@ -392,10 +390,8 @@ class BlockShader {
     const float w = m.mirrorWeight();
     b.diffuseWeight[i] = (1.0f - w) * (1.0f - m.transmission);
     b.alpha[i] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
-    if (!shader_.eyeLight()) {
-      const glm::vec3 &f0 = scene_.positions[t.x], &f1 = scene_.positions[t.y], &f2 = scene_.positions[t.z];
-      positions_[i] = b0 * glm::dvec3(f0) + double(h.b1) * glm::dvec3(f1) + double(h.b2) * glm::dvec3(f2);
-    }
+    if (!shader_.eyeLight())
+      positions_[i] = b0 * run_.p0 + double(h.b1) * run_.p1 + double(h.b2) * run_.p2;
   }
 
   // Shades the gathered lanes and writes their colours; empties the block.
@@ -448,6 +444,37 @@ class BlockShader {
   }
 
  private:
+  // What every lane on one triangle reads: its instance, corner indices,
+  // positions (double, exact), face normal (double and rounded) and
+  // authored corner normals (zero when the instance has none).
+  struct TriangleRun {
+    uint32_t instance = kNoId, triangle = kNoId;
+    const Instance* inst = nullptr;
+    glm::uvec3 corners{0};
+    glm::dvec3 p0{0.0}, p1{0.0}, p2{0.0};
+    glm::dvec3 ng{0.0, 0.0, 1.0};
+    glm::vec3 ngF{0.0f, 0.0f, 1.0f};
+    bool authored = false;
+    glm::vec3 n0{0.0f}, n1{0.0f}, n2{0.0f};
+  };
+
+  void startRun(uint32_t instance, uint32_t triangle) {
+    TriangleRun& r = run_;
+    r.instance = instance;
+    r.triangle = triangle;
+    r.inst = &scene_.instances[instance];
+    r.corners = scene_.triangle(instance, triangle);
+    r.p0 = glm::dvec3(scene_.positions[r.corners.x]);
+    r.p1 = glm::dvec3(scene_.positions[r.corners.y]);
+    r.p2 = glm::dvec3(scene_.positions[r.corners.z]);
+    r.ng = triangleFaceNormal(scene_, instance, triangle);
+    r.ngF = glm::vec3(r.ng);
+    r.authored = r.inst->normals == NormalSource::Authored;
+    r.n0 = r.authored ? scene_.normals[r.corners.x] : glm::vec3(0.0f);
+    r.n1 = r.authored ? scene_.normals[r.corners.y] : glm::vec3(0.0f);
+    r.n2 = r.authored ? scene_.normals[r.corners.z] : glm::vec3(0.0f);
+  }
+
   // Fills the lanes from `used` to a whole number of vectors with a
   // harmless surface (unit normals, no light, no colour), never read back.
   void padLanes() {
@@ -477,6 +504,7 @@ class BlockShader {
   const Scene& scene_;
   const size_t vectorLanes_;
   std::vector<LaneLight> lights_;
+  TriangleRun run_;
   LaneBlock block_;
   glm::vec4* outputs_[kBlock];
   glm::dvec3 positions_[kBlock];
