@@ -81,6 +81,11 @@ struct ShadingOptions {
   bool reflection = true;
   bool refraction = true;
   TextureFilter textureFilter = TextureFilter::Sampler;
+  // true: both renderers shade every primary hit with the scalar double
+  // Shader::shade (ShadingPath::Reference, common/shading_kernel.h)
+  // instead of the float SIMD kernel: the reference the kernel's error
+  // bound is stated against.
+  bool referenceShading = false;
 };
 
 class Shader {
@@ -116,6 +121,12 @@ class Shader {
 
   const TextureSet& textures() const { return *textures_; }
   const ShadingOptions& options() const { return options_; }
+  // What the shading kernel (common/shading_kernel.h) reads of this Shader.
+  const Scene& scene() const { return scene_; }
+  const Camera& camera() const { return camera_; }
+  const LightVisibility* visibility() const { return visibility_; }
+  const SecondaryRayTracer* secondary() const { return secondary_; }
+  bool eyeLight() const { return eyeLight_; }
 
  private:
   glm::vec3 directLight(const SurfacePoint& p, const glm::dvec3& n, const glm::dvec3& direction,

@@ -58,6 +58,12 @@ struct PlaneMemo {
   CornerBits key;
   int slot1, slot2;      // canonical (lexicographic) rank of stored corners 1 and 2
   glm::dvec3 a, e1, e2;  // first canonical corner, edges to the other two
+  // What depends on the triangle and the ray's origin alone, for the last
+  // origin (a perspective camera's primary rays share theirs): s = origin −
+  // a, q = s × e1 and e2·q, the same operations as without the memo.
+  bool originValid;
+  glm::dvec3 origin, s, q;
+  double e2DotQ;
 };
 struct NormalMemo {
   bool valid;
@@ -72,6 +78,18 @@ glm::dvec3 faceNormal(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dve
   const glm::dvec3 n = glm::cross(p1 - p0, p2 - p0);
   const double length = glm::length(n);
   return length > 0.0 ? n / length : glm::dvec3(0.0, 0.0, 1.0);
+}
+
+// The face normal (a square root and three divisions) from the memo when
+// the previous call was on the same triangle.
+inline glm::dvec3 memoisedFaceNormal(const glm::vec3& f0, const glm::vec3& f1, const glm::vec3& f2) {
+  NormalMemo& memo = normalMemo;
+  if (!memo.valid || !sameCorners(memo.key, f0, f1, f2)) {
+    memo.key = cornerBits(f0, f1, f2);
+    memo.normal = faceNormal(glm::dvec3(f0), glm::dvec3(f1), glm::dvec3(f2));
+    memo.valid = true;
+  }
+  return memo.normal;
 }
 
 // makeSurfacePoint from the hit's fields as values: callers pass b1 and b2
@@ -91,15 +109,7 @@ SurfacePoint surfacePointAt(const Scene& scene, uint32_t instance, uint32_t tria
   const glm::dvec3 p0(f0), p1(f1), p2(f2);
   sp.position = b0 * p0 + double(b1) * p1 + double(b2) * p2;
 
-  // The face normal (a square root and three divisions) from the memo when
-  // the previous point was on the same triangle.
-  NormalMemo& memo = normalMemo;
-  if (!memo.valid || !sameCorners(memo.key, f0, f1, f2)) {
-    memo.key = cornerBits(f0, f1, f2);
-    memo.normal = faceNormal(p0, p1, p2);
-    memo.valid = true;
-  }
-  sp.geometricNormal = memo.normal;
+  sp.geometricNormal = memoisedFaceNormal(f0, f1, f2);
   sp.shadingNormal = sp.geometricNormal;
   if (inst.normals == NormalSource::Authored) {
     const glm::dvec3 ns = b0 * glm::dvec3(scene.normals[t.x]) + double(b1) * glm::dvec3(scene.normals[t.y]) +
@@ -118,6 +128,11 @@ SurfacePoint surfacePointAt(const Scene& scene, uint32_t instance, uint32_t tria
 
 SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit) {
   return surfacePointAt(scene, hit.instance, hit.triangle, hit.b1, hit.b2);
+}
+
+glm::dvec3 triangleFaceNormal(const Scene& scene, uint32_t instance, uint32_t triangle) {
+  const glm::uvec3 t = scene.triangle(instance, triangle);
+  return memoisedFaceNormal(scene.positions[t.x], scene.positions[t.y], scene.positions[t.z]);
 }
 
 SurfacePoint surfacePointOnRay(const Scene& scene, const Ray& ray, const SampleHit& hit) {
@@ -165,18 +180,26 @@ bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t tria
     memo.e1 = corner[size_t(order[1])] - memo.a;
     memo.e2 = corner[size_t(order[2])] - memo.a;
     memo.valid = true;
+    memo.originValid = false;
   }
-  const glm::dvec3 a = memo.a, e1 = memo.e1, e2 = memo.e2;
+  const glm::dvec3 e1 = memo.e1, e2 = memo.e2;
+  // Compared bit for bit: −0 and +0 may give differently signed zeros in s.
+  if (!memo.originValid || std::memcmp(&memo.origin, &ray.origin, sizeof memo.origin) != 0) {
+    memo.origin = ray.origin;
+    memo.s = ray.origin - memo.a;
+    memo.q = glm::cross(memo.s, e1);
+    memo.e2DotQ = glm::dot(e2, memo.q);
+    memo.originValid = true;
+  }
   // Möller–Trumbore in double, without the inside test.
   const glm::dvec3 p = glm::cross(ray.direction, e2);
   const double det = glm::dot(e1, p);
   if (!(std::abs(det) > 0.0)) return false;
   const double inv = 1.0 / det;
-  const glm::dvec3 s = ray.origin - a;
+  const glm::dvec3 s = memo.s, q = memo.q;
   const double u = glm::dot(s, p) * inv;
-  const glm::dvec3 q = glm::cross(s, e1);
   const double w = glm::dot(ray.direction, q) * inv;
-  *t = glm::dot(e2, q) * inv;
+  *t = memo.e2DotQ * inv;
   // Back to the stored order: canonical corner 0 weighs 1 − u − w, 1 u, 2 w.
   const double w0 = 1.0 - u - w;
   auto weightOf = [&](int slot) { return slot == 0 ? w0 : slot == 1 ? u : w; };

@@ -32,6 +32,10 @@ struct SurfacePoint {
 };
 
 SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit);
+// The unit face normal of a stored triangle (CCW front; (0, 0, 1) when
+// degenerate), in double: makeSurfacePoint's geometricNormal, bit for bit
+// (the same per-thread memo).
+glm::dvec3 triangleFaceNormal(const Scene& scene, uint32_t instance, uint32_t triangle);
 // makeSurfacePoint(scene, refineHit(scene, ray, hit)), bit-identical, in one
 // call: the refined barycentrics go on in registers, not through a
 // SampleHit in memory (written in 4- and 8-byte pieces and read back as an

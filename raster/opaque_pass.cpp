@@ -7,6 +7,7 @@
 #include <functional>
 #include <utility>
 
+#include "common/shading_kernel.h"
 #include "raster/tile_renderer.h"
 
 namespace rastray {
@@ -27,24 +28,40 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
   TileSamples samples;
   samples.color.assign(index.count(), glm::vec4(0.0f));
   samples.front.assign(index.count(), SampleHit{});
-  std::vector<std::pair<uint64_t, glm::vec4>> pixelCache;  // shading rate pixel: one colour per triangle
+  // The tile's winning samples in two steps: gather the hits to shade
+  // (refined on their planes, in pixel and sample order), then shade them
+  // in one batch through the shading kernel (common/shading_kernel.h), the
+  // one the ray caster shades its primary hits with. Each sample takes the
+  // colour of the hit it shaded or, at shading rate pixel, of the first
+  // sample of its pixel on the same triangle. Per-thread scratch: no
+  // allocation per tile once grown.
+  struct Assignment {
+    uint32_t local;    // TileSampleIndex
+    uint32_t request;  // index into `requests`
+  };
+  thread_local std::vector<ShadeHit> requests;
+  thread_local std::vector<glm::vec4> colors;
+  thread_local std::vector<Assignment> assignments;
+  requests.clear();
+  assignments.clear();
+  std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, request)
   for (int py = rect.y0; py < rect.y1; ++py)
     for (int px = rect.x0; px < rect.x1; ++px) {
       pixelCache.clear();
       const glm::dvec2 corner(px, py);
+      const bool traced = trace.sink && px == trace.pixel.x && py == trace.pixel.y;
       for (int s = 0; s < spp; ++s) {
         const uint32_t win = target.winners[target.index(px, py, s)];
         if (win == kNoSetup) continue;
         const TriangleSetup& t = setups_[win];
         const uint32_t local = index(px, py, s);
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
-        const bool traced = trace.sink && px == trace.pixel.x && py == trace.pixel.y;
-        glm::vec4 c;
+        uint32_t request;
         if (options_.shadingRate == ShadingRate::Pixel) {
           auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
                                  [&](const auto& e) { return e.first == t.id(); });
           if (it != pixelCache.end()) {
-            c = it->second;
+            request = it->second;
             // The sample's own hit only where someone reads it: the
             // resolve's centre sample, the per-sample hits, the trace.
             if (allFronts || s == centre_ || traced) samples.front[local] = interpolatedHit(t, pos);
@@ -52,26 +69,41 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
             // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
             const SampleHit hit = interpolatedHit(t, pos);
             samples.front[local] = hit;
-            c = shadeAt(hit, pos, corner + glm::dvec2(0.5), n);
-            pixelCache.emplace_back(t.id(), c);
+            request = uint32_t(requests.size());
+            requests.push_back(refinePrimaryHit(scene_, rays_(pos), hit, corner + glm::dvec2(0.5)));
+            pixelCache.emplace_back(t.id(), request);
           }
         } else {
           const SampleHit hit = interpolatedHit(t, pos);
           samples.front[local] = hit;
-          c = shadeAt(hit, pos, pos, n);
+          request = uint32_t(requests.size());
+          requests.push_back(refinePrimaryHit(scene_, rays_(pos), hit, pos));
         }
-        samples.color[local] = c;
-        if (traced) {
-          const SampleHit& h = samples.front[local];
-          char b[64];
-          std::snprintf(b, sizeof b, "(%.6f, %.6f)", double(h.b1), double(h.b2));
-          trace.sink->record(TraceEvent{TraceStage::Shade, s, t.instance, t.triangle, 1, "", {}}
-                                 .add("interpolated_depth", traceNumber(h.depth))
-                                 .add("b", b)
-                                 .add("color", traceColor(c)));
-        }
+        assignments.push_back({local, request});
       }
     }
+  colors.resize(requests.size());
+  shadePrimaryHits(shader_, requests.data(), requests.size(), colors.data(), shadingPath());
+  n.shadedSamples += requests.size();
+  for (const Assignment& a : assignments) samples.color[a.local] = colors[a.request];
+
+  if (trace.sink && trace.pixel.x >= rect.x0 && trace.pixel.x < rect.x1 && trace.pixel.y >= rect.y0 &&
+      trace.pixel.y < rect.y1) {
+    const int px = trace.pixel.x, py = trace.pixel.y;
+    for (int s = 0; s < spp; ++s) {
+      const uint32_t win = target.winners[target.index(px, py, s)];
+      if (win == kNoSetup) continue;
+      const TriangleSetup& t = setups_[win];
+      const uint32_t local = index(px, py, s);
+      const SampleHit& h = samples.front[local];
+      char b[64];
+      std::snprintf(b, sizeof b, "(%.6f, %.6f)", double(h.b1), double(h.b2));
+      trace.sink->record(TraceEvent{TraceStage::Shade, s, t.instance, t.triangle, 1, "", {}}
+                             .add("interpolated_depth", traceNumber(h.depth))
+                             .add("b", b)
+                             .add("color", traceColor(samples.color[local])));
+    }
+  }
   return samples;
 }
 

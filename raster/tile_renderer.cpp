@@ -118,10 +118,13 @@ TextureFootprint TileRenderer::footprint(const SurfacePoint& p, const glm::dvec2
 
 glm::vec4 TileRenderer::shadeAt(const SampleHit& hit, const glm::dvec2& pos, const glm::dvec2& footprintPos,
                                 ThreadCounters& n) const {
-  Ray ray;
-  const SurfacePoint p = surfaceAt(hit, pos, &ray);
+  // One hit through the kernel: its rule (BLEND and tracing materials to
+  // Shader::shade) picks the path, as for the ray caster's same hit.
+  const ShadeHit request = refinePrimaryHit(scene_, rays_(pos), hit, footprintPos);
+  glm::vec4 c;
+  shadePrimaryHits(shader_, &request, 1, &c, shadingPath());
   ++n.shadedSamples;
-  return shader_.shade(p, ray.direction, footprint(p, footprintPos));
+  return c;
 }
 
 bool TileRenderer::alphaCovered(const TriangleSetup& t, int px, int py, int s) const {

@@ -32,6 +32,7 @@
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "common/shading.h"
+#include "common/shading_kernel.h"
 #include "common/surface.h"
 #include "raster/bin.h"
 #include "raster/coverage.h"
@@ -113,6 +114,11 @@ class TileRenderer {
                     ThreadCounters& n) const;
   bool alphaCovered(const TriangleSetup& t, int px, int py, int s) const;
   glm::dvec2 samplePosition(const TileSampleIndex& index, uint32_t local) const;
+  // The shading kernel's path for this frame's primary hits (opaque pass
+  // and BLEND layers alike): the kernel unless the reference is asked for.
+  ShadingPath shadingPath() const {
+    return shader_.options().referenceShading ? ShadingPath::Reference : ShadingPath::Kernel;
+  }
   CoveragePath coveragePath() const {
     return options_.referenceCoverage ? CoveragePath::Reference : CoveragePath::Fast;
   }

@@ -6,8 +6,9 @@
 // samples are box-filtered into the flat image. A ray that gathered no
 // BLEND layer (every ray of an opaque scene) is shaded straight from its
 // stopping hit when neither deep output nor a ray tree is wanted
-// (resolveStoppingHit: the surface list's result, bit for bit, without
-// the list; ≈ 4 % of the frame on the CAD model). The deep output keeps
+// (prepareStoppingHit: the surface list's result, bit for bit, without
+// the list; ≈ 4 % of the frame on the CAD model), those of a tile in one
+// batch through the shading kernel (common/shading_kernel.h). The deep output keeps
 // every sample's surfaces, per tile in one buffer, and is assembled into
 // one flat DeepImage at the end.
 //
@@ -65,6 +66,12 @@ struct TileScratch {
   std::vector<GatheredHit> closest;  // per sample: the stopping hit
   std::vector<SurfaceCrossing> crossings;
   std::vector<glm::vec4> sum;  // per pixel of the tile
+  // Phase 2: each sample's result, and the stopping hits shaded as one
+  // batch by the shading kernel (the samples they belong to, their colours).
+  std::vector<SampleResult> results;
+  std::vector<ShadeHit> stoppingHits;
+  std::vector<uint32_t> stoppingSamples;
+  std::vector<glm::vec4> stoppingColors;
   // The packets' trace order (traceOrder) for tiles of orderSize × orderSpp.
   std::vector<uint32_t> order;
   glm::ivec2 orderSize{0};
@@ -78,6 +85,7 @@ struct TileScratch {
         for (int s = 0; s < spp; ++s) samples.push_back({{x, y}, s});
     if (gathers.size() < samples.size()) gathers.resize(samples.size());
     if (closest.size() < samples.size()) closest.resize(samples.size());
+    if (results.size() < samples.size()) results.resize(samples.size());
     // Not cleared: each pixel's first sample sets its sum (renderTile).
     if (sum.size() < size_t(tile.width() * tile.height())) sum.resize(size_t(tile.width() * tile.height()));
   }
@@ -110,8 +118,9 @@ void setupPrimary(const CasterState& state, HitGather& g, glm::ivec2 pixel, cons
 SampleResult resolvePrimary(const CasterState& state, const RayTreeContext& context, HitGather& g,
                             const GatheredHit& closest, uint32_t sampleIndex, std::vector<DeepSample>* deep,
                             std::vector<SurfaceCrossing>* crossings);
-SampleResult resolveStoppingHit(const CasterState& state, const RayTreeContext& context, const HitGather& g,
-                                const GatheredHit& closest);
+bool stoppingHitOnly(const HitGather& g, const std::vector<DeepSample>* deep, const RayTreeContext& context);
+bool prepareStoppingHit(const CasterState& state, const RayTreeContext& context, const HitGather& g,
+                        const GatheredHit& closest, SampleResult* r, ShadeHit* shade);
 
 }  // namespace
 
@@ -194,15 +203,46 @@ void renderTile(const CasterState& state, const Tile& tile, const std::vector<gl
   }
   const Clock::time_point traced = Clock::now();
 
-  // Phase 2: their surfaces shaded, filtered into the tile's pixels.
+  // Phase 2: their surfaces shaded, filtered into the tile's pixels. A
+  // sample whose surface list is its stopping hit alone (every sample of
+  // an opaque scene) joins the tile's batch for the shading kernel
+  // (common/shading_kernel.h), which the rasterizer's samples go through
+  // too; the others are resolved one by one, their deep samples appended
+  // in sample order.
   FlatImage& img = *image;
+  std::vector<SampleResult>& results = scratch.results;
+  scratch.stoppingHits.clear();
+  scratch.stoppingSamples.clear();
+  for (size_t i = 0; i < n; ++i) {
+    const TileSample& s = samples[i];
+    HitGather& g = scratch.gathers[i];
+    if (stoppingHitOnly(g, tileDeep, context)) {
+      ShadeHit shade;
+      if (prepareStoppingHit(state, context, g, scratch.closest[i], &results[i], &shade)) {
+        scratch.stoppingHits.push_back(shade);
+        scratch.stoppingSamples.push_back(uint32_t(i));
+      }
+      continue;
+    }
+    const size_t pixel = img.index(s.pixel.x, s.pixel.y);
+    const size_t before = tileDeep ? tileDeep->size() : 0;
+    results[i] = resolvePrimary(state, context, g, scratch.closest[i], uint32_t(s.sample), tileDeep,
+                                &scratch.crossings);
+    if (tileDeep) (*pixelCounts)[pixel] += uint32_t(tileDeep->size() - before);
+  }
+  scratch.stoppingColors.resize(scratch.stoppingHits.size());
+  shadePrimaryHits(*context.shader, scratch.stoppingHits.data(), scratch.stoppingHits.size(),
+                   scratch.stoppingColors.data(), shadingPath(state));
+  for (size_t k = 0; k < scratch.stoppingSamples.size(); ++k) {
+    // composite's first `over` of a surface with nothing in front of it:
+    // 0 + remaining·c, remaining = 1 (−0 becomes +0).
+    const float remaining = 1.0f - 0.0f;
+    results[scratch.stoppingSamples[k]].color = glm::vec4(0.0f) + remaining * scratch.stoppingColors[k];
+  }
   for (size_t i = 0; i < n; ++i) {
     const TileSample& s = samples[i];
     const size_t pixel = img.index(s.pixel.x, s.pixel.y);
-    const size_t before = tileDeep ? tileDeep->size() : 0;
-    const SampleResult r = resolvePrimary(state, context, scratch.gathers[i], scratch.closest[i],
-                                          uint32_t(s.sample), tileDeep, &scratch.crossings);
-    if (tileDeep) (*pixelCounts)[pixel] += uint32_t(tileDeep->size() - before);
+    const SampleResult& r = results[i];
     glm::vec4& sum = scratch.sum[size_t((s.pixel.y - tile.y0) * tile.width() + (s.pixel.x - tile.x0))];
     // The sum from 0 in sample order: 0 + the first (as a cleared sum
     // would give: −0 becomes +0), then += the others.
@@ -396,41 +436,47 @@ void setupPrimary(const CasterState& state, HitGather& g, glm::ivec2 pixel, cons
   g.hits.clear();
 }
 
-// resolvePrimary when the ray gathered no layer (every ray of an opaque
-// scene) and neither deep samples nor a ray tree are wanted: its surface
-// list is the stopping hit alone (or nothing), so this is collectCrossings
-// and composite for that one surface, kept in registers rather than built
-// in the crossing list and read back (the list's entry was written field
-// by field and read back in wider pieces: a store-forwarding stall per
-// ray). The same operations in the same order, so the same bits: the
-// surface point as surfacePointOnRay refines it (appendSurfaceCrossing's
-// refinement, then makeSurfacePoint), depth Embree's t × depthPerT, and
-// the colour 0 + 1·c as composite's first `over` makes it.
-SampleResult resolveStoppingHit(const CasterState& state, const RayTreeContext& context, const HitGather& g,
-                                const GatheredHit& closest) {
-  SampleResult r;
-  if (closest.instance == kNoId) return r;  // a miss: no surface, colour 0
-  r.front.instance = closest.instance;
-  r.front.triangle = closest.triangle;
-  r.front.depth = float(double(closest.traversalT) * g.ray.depthPerT);
+// Whether a traced primary ray's surface list is its stopping hit alone
+// (it gathered no layer: every ray of an opaque scene) and neither deep
+// samples nor a ray tree are wanted: then it is resolved from that hit
+// (prepareStoppingHit), without building the list.
+bool stoppingHitOnly(const HitGather& g, const std::vector<DeepSample>* deep, const RayTreeContext& context) {
+  return g.hits.empty() && !deep && !context.recorder;
+}
+
+// collectCrossings and composite for that one surface, kept in registers
+// rather than built in the crossing list and read back (the list's entry
+// was written field by field and read back in wider pieces: a
+// store-forwarding stall per ray). The same operations in the same order,
+// so the same bits: the hit refined as appendSurfaceCrossing refines it
+// (refinePrimaryHit, surfacePointOnRay's steps), depth Embree's t ×
+// depthPerT. Sets r's front surface; returns whether the hit is to be
+// shaded (`shade`: its colour c then makes r.color = 0 + 1·c, as
+// composite's first `over`); false for a miss or when the cutoff stops it.
+bool prepareStoppingHit(const CasterState& state, const RayTreeContext& context, const HitGather& g,
+                        const GatheredHit& closest, SampleResult* r, ShadeHit* shade) {
+  *r = SampleResult{};
+  if (closest.instance == kNoId) return false;  // a miss: no surface, colour 0
+  r->front.instance = closest.instance;
+  r->front.triangle = closest.triangle;
+  r->front.depth = float(double(closest.traversalT) * g.ray.depthPerT);
   SampleHit hit;
   hit.instance = closest.instance;
   hit.triangle = closest.triangle;
   hit.b1 = closest.u;
   hit.b2 = closest.v;
-  hit.depth = r.front.depth;
-  const SurfacePoint p = surfacePointOnRay(state.scene, g.ray, hit);
-  r.front.b1 = p.b1;  // the refined barycentrics, as the list's entry has them
-  r.front.b2 = p.b2;
+  hit.depth = r->front.depth;
+  *shade = refinePrimaryHit(state.scene, g.ray, hit, g.imagePosition);
+  r->front.b1 = shade->b1;  // the refined barycentrics, as the list's entry has them
+  r->front.b2 = shade->b2;
   const float remaining = 1.0f - 0.0f;  // nothing in front of it
-  if (remaining < state.options.transparencyCutoff) return r;
-  const TextureFootprint fp = pixelFootprint(state.scene, state.camera, p, g.imagePosition);
-  const glm::vec4 c = context.shader->shade(p, g.ray.direction, fp, 0, 1.0f * remaining);
-  r.color = glm::vec4(0.0f) + remaining * c;
+  if (remaining < state.options.transparencyCutoff) return false;
+  shade->throughput = 1.0f * remaining;
   // A BLEND surface that stopped the ray (no filter gathered it): the ray
   // would continue behind it, but nothing was found there.
-  if (p.material->alphaMode == AlphaMode::Blend) context.count(RayKind::Transparency);
-  return r;
+  if (state.scene.materialOf(closest.instance).alphaMode == AlphaMode::Blend)
+    context.count(RayKind::Transparency);
+  return true;
 }
 
 // A traced primary ray's surfaces, shaded: the sample's colour, and its
@@ -438,7 +484,16 @@ SampleResult resolveStoppingHit(const CasterState& state, const RayTreeContext& 
 SampleResult resolvePrimary(const CasterState& state, const RayTreeContext& context, HitGather& g,
                             const GatheredHit& closest, uint32_t sampleIndex, std::vector<DeepSample>* deep,
                             std::vector<SurfaceCrossing>* crossings) {
-  if (g.hits.empty() && !deep && !context.recorder) return resolveStoppingHit(state, context, g, closest);
+  if (stoppingHitOnly(g, deep, context)) {
+    SampleResult r;
+    ShadeHit shade;
+    if (prepareStoppingHit(state, context, g, closest, &r, &shade)) {
+      glm::vec4 c;
+      shadePrimaryHits(*context.shader, &shade, 1, &c, shadingPath(state));
+      r.color = glm::vec4(0.0f) + 1.0f * c;
+    }
+    return r;
+  }
   collectCrossings(state, g, closest, crossings);
   SampleResult r;
   if (!crossings->empty()) {

@@ -129,13 +129,25 @@ Composited composite(const CasterState& state, const RayTreeContext& context, in
       if (deep.samples && !deep.samples->empty()) deep.samples->back().cutOff = true;
       break;
     }
-    const SurfacePoint p = makeSurfacePoint(state.scene, crossing.refined);
-    const TextureFootprint fp =
-        g.primary ? pixelFootprint(state.scene, state.camera, p, g.imagePosition) : TextureFootprint{};
     glm::vec4 c;
     {
       const ShadingDepthScope shading(context.recorder, depth);
-      c = context.shader->shade(p, g.ray.direction, fp, depth, throughput * remaining);
+      if (g.primary) {
+        // A primary surface: through the shading kernel, as the rasterizer
+        // (hybrid) shades the same refined hit.
+        ShadeHit hit;
+        hit.instance = crossing.refined.instance;
+        hit.triangle = crossing.refined.triangle;
+        hit.b1 = crossing.refined.b1;
+        hit.b2 = crossing.refined.b2;
+        hit.direction = g.ray.direction;
+        hit.footprintPosition = g.imagePosition;
+        hit.throughput = throughput * remaining;
+        shadePrimaryHits(*context.shader, &hit, 1, &c, shadingPath(state));
+      } else {
+        const SurfacePoint p = makeSurfacePoint(state.scene, crossing.refined);
+        c = context.shader->shade(p, g.ray.direction, TextureFootprint{}, depth, throughput * remaining);
+      }
     }
     acc.color += remaining * c;
     ++acc.layers;

@@ -41,6 +41,7 @@
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "common/shading.h"
+#include "common/shading_kernel.h"
 #include "common/surface.h"
 #include "raytrace/embree_scene.h"
 #include "raytrace/ray_caster.h"
@@ -156,6 +157,12 @@ struct CasterState {
   std::unique_ptr<Shader> shader;  // calls back into the RayCaster: untraced rays
   mutable tbb::enumerable_thread_specific<ThreadRays> threads;
 };
+
+// The shading kernel's path for this caster's primary hits: the kernel
+// unless the reference is asked for (ShadingOptions::referenceShading).
+inline ShadingPath shadingPath(const CasterState& state) {
+  return state.options.shading.referenceShading ? ShadingPath::Reference : ShadingPath::Kernel;
+}
 
 // --- the context one ray tree is traced in ------------------------------------
 

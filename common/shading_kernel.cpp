@@ -1,0 +1,547 @@
+// The primary-hit shading kernel (shading_kernel.h). Highway compiles the
+// lane functions below once per SIMD target (foreach_target.h re-includes
+// this file); the host code at the end gathers hits into blocks of lanes,
+// runs the lanes through HWY_DYNAMIC_DISPATCH and scatters the colours.
+// Built with -ffp-contract=off (common/CMakeLists.txt): see the header's
+// invariants.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "common/shading_kernel.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <cstddef>
+#include <limits>
+
+#include <hwy/highway.h>
+
+#include "common/shading_kernel.h"
+
+#ifndef RASTRAY_SHADING_KERNEL_LANES
+#define RASTRAY_SHADING_KERNEL_LANES
+namespace rastray {
+namespace kernel_detail {
+
+// Lanes per block: a multiple of every target's float lane count (4, 8, 16),
+// so a block is whole vectors; a partial block is padded (padLanes).
+constexpr size_t kBlock = 64;
+
+// One block of lanes, struct of arrays. Filled by the host (gather), read
+// and written by the lane functions.
+struct LaneBlock {
+  size_t used = 0;   // lanes holding a hit
+  size_t lanes = 0;  // used rounded up to whole vectors of the running target: what the lanes run over
+  // Inputs.
+  alignas(64) float dirX[kBlock], dirY[kBlock], dirZ[kBlock];  // primary ray direction
+  alignas(64) float side[kBlock];                           // +1 entering (d·ng < 0, in double), else −1
+  alignas(64) float ngX[kBlock], ngY[kBlock], ngZ[kBlock];  // face normal (double, memoised), rounded
+  alignas(64) float authored[kBlock];  // 1: interpolate the corner normals below, 0: the face normal
+  alignas(64) float b0[kBlock], b1[kBlock], b2[kBlock];  // b0 = 1 − b1 − b2 in double, rounded
+  alignas(64) float n0X[kBlock], n0Y[kBlock], n0Z[kBlock];
+  alignas(64) float n1X[kBlock], n1Y[kBlock], n1Z[kBlock];
+  alignas(64) float n2X[kBlock], n2Y[kBlock], n2Z[kBlock];
+  alignas(64) float albedoR[kBlock], albedoG[kBlock], albedoB[kBlock];  // base colour RGB (scalar, as Shader)
+  alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
+  alignas(64) float diffuseWeight[kBlock];                              // (1 − w)(1 − t)
+  alignas(64) float alpha[kBlock];                                      // BLEND: base alpha; else 1
+  // Per light, refilled for each light: position − light in double, rounded.
+  alignas(64) float toLightX[kBlock], toLightY[kBlock], toLightZ[kBlock];
+  // Per light: E·cosθ where the light reaches the lane (else 0), then the
+  // host's transmittance V per channel.
+  alignas(64) float weight[kBlock];
+  alignas(64) float visR[kBlock], visG[kBlock], visB[kBlock];
+  // Intermediate: the lighting normal, the Lambert sum.
+  alignas(64) float nX[kBlock], nY[kBlock], nZ[kBlock];
+  alignas(64) float sumR[kBlock], sumG[kBlock], sumB[kBlock];
+  // Output: premultiplied RGBA.
+  alignas(64) float outR[kBlock], outG[kBlock], outB[kBlock], outA[kBlock];
+};
+
+// A light's uniform parameters, in float (computed in double, rounded).
+struct LaneLight {
+  int type;  // 0 point, 1 spot, 2 directional
+  float colorR, colorG, colorB;
+  float intensity;
+  float range;                // 0: none
+  float spotX, spotY, spotZ;  // the way light travels (spot)
+  float cosOuter;             // spot: t = (cd − cosOuter) / coneDenominator
+  float coneDenominator;      // max(1e-6, cos inner − cos outer)
+  float dirX, dirY, dirZ;     // directional: unit, towards the light
+};
+
+}  // namespace kernel_detail
+}  // namespace rastray
+#endif
+
+HWY_BEFORE_NAMESPACE();
+namespace rastray {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+using kernel_detail::LaneBlock;
+using kernel_detail::LaneLight;
+
+// Lanes per vector of the running target.
+size_t KernelLanes() { return hn::Lanes(hn::ScalableTag<float>()); }
+
+// The lighting normal of each lane (Shader::shade's n): the shading
+// normal (authored, interpolated and normalised; else the face normal) on
+// the viewer's side, or the face normal's when that one faces away.
+// Clears the Lambert sum; with the eye light, sets it to |n·d|.
+void LanesNormals(LaneBlock* b, bool eyeLight) {
+  const hn::ScalableTag<float> d;
+  const size_t N = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto inf = hn::Set(d, std::numeric_limits<float>::infinity());
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const auto b0 = hn::Load(d, b->b0 + i), b1 = hn::Load(d, b->b1 + i), b2 = hn::Load(d, b->b2 + i);
+    const auto sx =
+        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0X + i)), hn::Mul(b1, hn::Load(d, b->n1X + i))),
+                hn::Mul(b2, hn::Load(d, b->n2X + i)));
+    const auto sy =
+        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0Y + i)), hn::Mul(b1, hn::Load(d, b->n1Y + i))),
+                hn::Mul(b2, hn::Load(d, b->n2Y + i)));
+    const auto sz =
+        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0Z + i)), hn::Mul(b1, hn::Load(d, b->n1Z + i))),
+                hn::Mul(b2, hn::Load(d, b->n2Z + i)));
+    const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(sx, sx), hn::Mul(sy, sy)), hn::Mul(sz, sz)));
+    const auto gx = hn::Load(d, b->ngX + i), gy = hn::Load(d, b->ngY + i), gz = hn::Load(d, b->ngZ + i);
+    // A zero (or overflowing) interpolated normal keeps the face normal.
+    const auto useAuthored = hn::And(hn::Gt(hn::Load(d, b->authored + i), zero),
+                                     hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
+    const auto side = hn::Load(d, b->side + i);
+    const auto fx = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sx, length), gx));
+    const auto fy = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sy, length), gy));
+    const auto fz = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sz, length), gz));
+    const auto dx = hn::Load(d, b->dirX + i), dy = hn::Load(d, b->dirY + i), dz = hn::Load(d, b->dirZ + i);
+    // facing·(−d) > 0, written as facing·d < 0 (negation is exact).
+    const auto facingDot = hn::Add(hn::Add(hn::Mul(fx, dx), hn::Mul(fy, dy)), hn::Mul(fz, dz));
+    const auto faces = hn::Lt(facingDot, zero);
+    const auto nx = hn::IfThenElse(faces, fx, hn::Mul(side, gx));
+    const auto ny = hn::IfThenElse(faces, fy, hn::Mul(side, gy));
+    const auto nz = hn::IfThenElse(faces, fz, hn::Mul(side, gz));
+    hn::Store(nx, d, b->nX + i);
+    hn::Store(ny, d, b->nY + i);
+    hn::Store(nz, d, b->nZ + i);
+    if (eyeLight) {
+      // A light at the eye: albedo·|n·d|, no falloff, no shadows.
+      const auto cosine = hn::Abs(hn::Add(hn::Add(hn::Mul(nx, dx), hn::Mul(ny, dy)), hn::Mul(nz, dz)));
+      hn::Store(cosine, d, b->sumR + i);
+      hn::Store(cosine, d, b->sumG + i);
+      hn::Store(cosine, d, b->sumB + i);
+    } else {
+      hn::Store(zero, d, b->sumR + i);
+      hn::Store(zero, d, b->sumG + i);
+      hn::Store(zero, d, b->sumB + i);
+    }
+  }
+}
+
+// One light's E·cosθ per lane (0 where it does not reach the lane), from
+// toLight* (point, spot: the vector from the surface to the light) or the
+// light's direction (directional).
+void LanesLightWeight(LaneBlock* b, const LaneLight& light) {
+  const hn::ScalableTag<float> d;
+  const size_t N = hn::Lanes(d);
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    auto lx = hn::Set(d, light.dirX), ly = hn::Set(d, light.dirY), lz = hn::Set(d, light.dirZ);
+    auto irradiance = hn::Set(d, light.intensity);
+    auto reaches = hn::Eq(zero, zero);
+    if (light.type != 2) {
+      const auto vx = hn::Load(d, b->toLightX + i), vy = hn::Load(d, b->toLightY + i),
+                 vz = hn::Load(d, b->toLightZ + i);
+      const auto distance = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), hn::Mul(vz, vz)));
+      reaches = hn::Gt(distance, zero);
+      lx = hn::Div(vx, distance);
+      ly = hn::Div(vy, distance);
+      lz = hn::Div(vz, distance);
+      // I / d², as two divisions: d² alone would overflow float sooner.
+      irradiance = hn::Div(hn::Div(irradiance, distance), distance);
+      if (light.range > 0.0f) {
+        // glTF's range window: clamp(1 − (d / range)⁴, 0, 1).
+        const auto r = hn::Div(distance, hn::Set(d, light.range));
+        const auto r2 = hn::Mul(r, r);
+        irradiance = hn::Mul(irradiance, hn::Min(hn::Max(hn::Sub(one, hn::Mul(r2, r2)), zero), one));
+      }
+      if (light.type == 1) {
+        // The cone: cd = spot·(−l), t = clamp((cd − cos outer) / denominator, 0, 1), weight t².
+        const auto cd = hn::Neg(
+            hn::Add(hn::Add(hn::Mul(hn::Set(d, light.spotX), lx), hn::Mul(hn::Set(d, light.spotY), ly)),
+                    hn::Mul(hn::Set(d, light.spotZ), lz)));
+        const auto t = hn::Min(
+            hn::Max(hn::Div(hn::Sub(cd, hn::Set(d, light.cosOuter)), hn::Set(d, light.coneDenominator)),
+                    zero),
+            one);
+        irradiance = hn::Mul(irradiance, hn::Mul(t, t));
+      }
+    }
+    const auto cosine =
+        hn::Add(hn::Add(hn::Mul(hn::Load(d, b->nX + i), lx), hn::Mul(hn::Load(d, b->nY + i), ly)),
+                hn::Mul(hn::Load(d, b->nZ + i), lz));
+    reaches = hn::And(reaches, hn::And(hn::Gt(cosine, zero), hn::Gt(irradiance, zero)));
+    hn::Store(hn::IfThenElseZero(reaches, hn::Mul(irradiance, cosine)), d, b->weight + i);
+  }
+}
+
+// sum += light colour · V · weight, per lane (V: visR/G/B when
+// `visibility`, else 1).
+void LanesAccumulate(LaneBlock* b, const LaneLight& light, bool visibility) {
+  const hn::ScalableTag<float> d;
+  const size_t N = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const auto w = hn::Load(d, b->weight + i);
+    const auto lit = hn::Gt(w, zero);
+    auto r = hn::Set(d, light.colorR), g = hn::Set(d, light.colorG), bl = hn::Set(d, light.colorB);
+    if (visibility) {
+      r = hn::Mul(r, hn::Load(d, b->visR + i));
+      g = hn::Mul(g, hn::Load(d, b->visG + i));
+      bl = hn::Mul(bl, hn::Load(d, b->visB + i));
+    }
+    // Unlit lanes add nothing (not 0·V: V is not set there).
+    hn::Store(hn::Add(hn::Load(d, b->sumR + i), hn::IfThenElseZero(lit, hn::Mul(r, w))), d, b->sumR + i);
+    hn::Store(hn::Add(hn::Load(d, b->sumG + i), hn::IfThenElseZero(lit, hn::Mul(g, w))), d, b->sumG + i);
+    hn::Store(hn::Add(hn::Load(d, b->sumB + i), hn::IfThenElseZero(lit, hn::Mul(bl, w))), d, b->sumB + i);
+  }
+}
+
+// L = emission + (1 − w)(1 − t)·albedo·sum/π (the eye light: albedo·|n·d|),
+// premultiplied by alpha.
+void LanesFinish(LaneBlock* b, bool eyeLight) {
+  const hn::ScalableTag<float> d;
+  const size_t N = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto invPi = hn::Set(d, eyeLight ? 1.0f : float(0.31830988618379067154));
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const auto diffuse = hn::Load(d, b->diffuseWeight + i);
+    const auto hasDiffuse = hn::Gt(diffuse, zero);
+    const auto alpha = hn::Load(d, b->alpha + i);
+    const auto channel = [&](const float* albedo, const float* sum, const float* emit, float* out) {
+      const auto direct = hn::Mul(hn::Load(d, albedo + i), hn::Mul(hn::Load(d, sum + i), invPi));
+      const auto e = hn::Load(d, emit + i);
+      const auto L = hn::IfThenElse(hasDiffuse, hn::Add(e, hn::Mul(diffuse, direct)), e);
+      hn::Store(hn::Mul(L, alpha), d, out + i);
+    };
+    channel(b->albedoR, b->sumR, b->emitR, b->outR);
+    channel(b->albedoG, b->sumG, b->emitG, b->outG);
+    channel(b->albedoB, b->sumB, b->emitB, b->outB);
+    hn::Store(alpha, d, b->outA + i);
+  }
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace rastray
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "common/optics.h"
+#include "common/shading.h"
+#include "common/surface.h"
+
+namespace rastray {
+
+HWY_EXPORT(KernelLanes);
+HWY_EXPORT(LanesNormals);
+HWY_EXPORT(LanesLightWeight);
+HWY_EXPORT(LanesAccumulate);
+HWY_EXPORT(LanesFinish);
+
+using kernel_detail::kBlock;
+using kernel_detail::LaneBlock;
+using kernel_detail::LaneLight;
+
+ShadeHit refinePrimaryHit(const Scene& scene, const Ray& ray, const SampleHit& hit,
+                          const glm::dvec2& footprintPosition) {
+  ShadeHit s;
+  s.instance = hit.instance;
+  s.triangle = hit.triangle;
+  s.b1 = hit.b1;
+  s.b2 = hit.b2;
+  s.direction = ray.direction;
+  s.footprintPosition = footprintPosition;
+  // surfacePointOnRay's refinement: kept when the plane is missed or behind.
+  double t;
+  glm::dvec2 b, clamped;
+  if (intersectTrianglePlane(scene, hit.instance, hit.triangle, ray, &t, &b) &&
+      refinedBarycentrics(ray, t, b, &clamped)) {
+    s.b1 = float(clamped.x);
+    s.b2 = float(clamped.y);
+  }
+  return s;
+}
+
+namespace {
+
+// The scalar double reference for one hit: exactly what a renderer did
+// before the kernel (surfacePointOnRay's point, pixelFootprint, shade).
+
+// Whether Shader::shade at depth 0 would trace a secondary ray from this
+// material (or it is BLEND): such lanes take the scalar path, in every
+// renderer alike.
+bool needsScalarShade(const Shader& shader, const Material& m) {
+  if (m.alphaMode == AlphaMode::Blend) return true;
+  const bool canTrace = shader.secondary() && 0 < shader.options().maxDepth;
+  return canTrace && (m.mirrorWeight() > 0.0f || (1.0f - m.mirrorWeight()) * m.transmission > 0.0f);
+}
+
+bool samplesTexture(const Shader& shader, const Material& m) {
+  if (shader.textures().empty()) return false;
+  return m.baseColorTexture >= 0 || (m.emissiveTexture >= 0 && m.emissive != glm::vec3(0.0f));
+}
+
+// The footprint only where a texture is sampled: elsewhere it is unused.
+glm::vec4 shadeReference(const Shader& shader, const ShadeHit& h) {
+  const SurfacePoint p =
+      makeSurfacePoint(shader.scene(), SampleHit{h.instance, h.triangle, 0.0f, h.b1, h.b2});
+  const TextureFootprint fp = samplesTexture(shader, *p.material)
+                                  ? pixelFootprint(shader.scene(), shader.camera(), p, h.footprintPosition)
+                                  : TextureFootprint{};
+  return shader.shade(p, h.direction, fp, 0, h.throughput);
+}
+
+LaneLight laneLight(const Light& light) {
+  LaneLight l{};
+  l.type = light.type == LightType::Point ? 0 : light.type == LightType::Spot ? 1 : 2;
+  l.colorR = light.color.r;
+  l.colorG = light.color.g;
+  l.colorB = light.color.b;
+  l.intensity = light.intensity;
+  l.range = light.range;
+  l.spotX = float(light.direction.x);
+  l.spotY = float(light.direction.y);
+  l.spotZ = float(light.direction.z);
+  const double cosOuter = std::cos(light.outerConeAngle), cosInner = std::cos(light.innerConeAngle);
+  l.cosOuter = float(cosOuter);
+  l.coneDenominator = float(std::max(1e-6, cosInner - cosOuter));
+  l.dirX = float(-light.direction.x);
+  l.dirY = float(-light.direction.y);
+  l.dirZ = float(-light.direction.z);
+  return l;
+}
+
+// The host side of one block: the scalar per-lane work around the lanes.
+class BlockShader {
+ public:
+  explicit BlockShader(const Shader& shader)
+      : shader_(shader), scene_(shader.scene()), vectorLanes_(HWY_DYNAMIC_DISPATCH(KernelLanes)()) {
+    for (const Light& light : scene_.lights) lights_.push_back(laneLight(light));
+  }
+
+  bool full() const { return block_.used == kBlock; }
+
+  // Gathers hit `h` (to be written to `*out`) into the next lane.
+  void add(const ShadeHit& h, const Material& m, glm::vec4* out) {
+    const size_t i = block_.used++;
+    LaneBlock& b = block_;
+    outputs_[i] = out;
+    // Consecutive hits mostly share a triangle: its data is looked up once
+    // per run (the same values, so the lane does not depend on the run).
+    if (h.instance != run_.instance || h.triangle != run_.triangle) startRun(h.instance, h.triangle);
+    const Instance& inst = *run_.inst;
+    const glm::uvec3 t = run_.corners;
+    const double b0 = 1.0 - double(h.b1) - double(h.b2);
+    // The side in double, from the face normal in double, as
+    // makeSurfacePoint and Shader::shade decide it.
+    const bool entering = isEntering(h.direction, run_.ng);
+    b.side[i] = entering ? 1.0f : -1.0f;
+    b.ngX[i] = run_.ngF.x;
+    b.ngY[i] = run_.ngF.y;
+    b.ngZ[i] = run_.ngF.z;
+    b.dirX[i] = float(h.direction.x);
+    b.dirY[i] = float(h.direction.y);
+    b.dirZ[i] = float(h.direction.z);
+    b.b0[i] = float(b0);
+    b.b1[i] = h.b1;
+    b.b2[i] = h.b2;
+    b.authored[i] = run_.authored ? 1.0f : 0.0f;
+    b.n0X[i] = run_.n0.x, b.n0Y[i] = run_.n0.y, b.n0Z[i] = run_.n0.z;
+    b.n1X[i] = run_.n1.x, b.n1Y[i] = run_.n1.y, b.n1Z[i] = run_.n1.z;
+    b.n2X[i] = run_.n2.x, b.n2Y[i] = run_.n2.y, b.n2Z[i] = run_.n2.z;
+
+    // Base colour and emission: Shader::baseColor and emission's float
+    // steps, here with the textures sampled through the pixel footprint.
+    glm::vec4 base = m.baseColorFactor;
+    glm::vec3 emit = m.emissive;
+    const bool textured = samplesTexture(shader_, m);
+    const bool visible = shader_.visibility() && !shader_.eyeLight() && !scene_.lights.empty();
+    if (textured || visible) {
+      // The full surface point: the footprint and the visibility callback
+      // take it (the same one Shader::shade would get).
+      points_[i] = makeSurfacePoint(scene_, SampleHit{h.instance, h.triangle, 0.0f, h.b1, h.b2});
+    }
+    if (textured) {
+      const TextureFootprint fp = pixelFootprint(scene_, shader_.camera(), points_[i], h.footprintPosition);
+      base = shader_.baseColor(points_[i], fp);
+      emit = shader_.emission(points_[i], fp);
+    } else if (inst.hasColors) {
+      const glm::vec4 color =
+          float(b0) * scene_.colors[t.x] + h.b1 * scene_.colors[t.y] + h.b2 * scene_.colors[t.z];
+      base *= color;
+    }
+    b.albedoR[i] = base.r;
+    b.albedoG[i] = base.g;
+    b.albedoB[i] = base.b;
+    b.emitR[i] = emit.r;
+    b.emitG[i] = emit.g;
+    b.emitB[i] = emit.b;
+    const float w = m.mirrorWeight();
+    b.diffuseWeight[i] = (1.0f - w) * (1.0f - m.transmission);
+    b.alpha[i] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
+    if (!shader_.eyeLight())
+      positions_[i] = b0 * run_.p0 + double(h.b1) * run_.p1 + double(h.b2) * run_.p2;
+  }
+
+  // Shades the gathered lanes and writes their colours; empties the block.
+  void run() {
+    LaneBlock& b = block_;
+    if (b.used == 0) return;
+    padLanes();
+    const bool eyeLight = shader_.eyeLight();
+    HWY_DYNAMIC_DISPATCH(LanesNormals)(&b, eyeLight);
+    if (!eyeLight) {
+      const LightVisibility* visibility = shader_.visibility();
+      for (size_t l = 0; l < lights_.size(); ++l) {
+        const Light& light = scene_.lights[l];
+        if (light.type != LightType::Directional) {
+          // The vector to the light in double, rounded once.
+          for (size_t i = 0; i < b.used; ++i) {
+            const glm::dvec3 v = light.position - positions_[i];
+            b.toLightX[i] = float(v.x);
+            b.toLightY[i] = float(v.y);
+            b.toLightZ[i] = float(v.z);
+          }
+        }
+        HWY_DYNAMIC_DISPATCH(LanesLightWeight)(&b, lights_[l]);
+        if (visibility) {
+          for (size_t i = 0; i < b.used; ++i) {
+            if (!(b.weight[i] > 0.0f)) continue;
+            // Shader::directLight's direction and distance, in double.
+            glm::dvec3 toLight;
+            double distance;
+            if (light.type == LightType::Directional) {
+              toLight = -light.direction;
+              distance = std::numeric_limits<double>::infinity();
+            } else {
+              const glm::dvec3 v = light.position - points_[i].position;
+              distance = glm::length(v);
+              toLight = v / distance;
+            }
+            const glm::vec3 v = visibility->transmittance(points_[i], int(l), toLight, distance);
+            b.visR[i] = v.r;
+            b.visG[i] = v.g;
+            b.visB[i] = v.b;
+          }
+        }
+        HWY_DYNAMIC_DISPATCH(LanesAccumulate)(&b, lights_[l], visibility != nullptr);
+      }
+    }
+    HWY_DYNAMIC_DISPATCH(LanesFinish)(&b, eyeLight);
+    for (size_t i = 0; i < b.used; ++i) *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
+    b.used = 0;
+  }
+
+ private:
+  // What every lane on one triangle reads: its instance, corner indices,
+  // positions (double, exact), face normal (double and rounded) and
+  // authored corner normals (zero when the instance has none).
+  struct TriangleRun {
+    uint32_t instance = kNoId, triangle = kNoId;
+    const Instance* inst = nullptr;
+    glm::uvec3 corners{0};
+    glm::dvec3 p0{0.0}, p1{0.0}, p2{0.0};
+    glm::dvec3 ng{0.0, 0.0, 1.0};
+    glm::vec3 ngF{0.0f, 0.0f, 1.0f};
+    bool authored = false;
+    glm::vec3 n0{0.0f}, n1{0.0f}, n2{0.0f};
+  };
+
+  void startRun(uint32_t instance, uint32_t triangle) {
+    TriangleRun& r = run_;
+    r.instance = instance;
+    r.triangle = triangle;
+    r.inst = &scene_.instances[instance];
+    r.corners = scene_.triangle(instance, triangle);
+    r.p0 = glm::dvec3(scene_.positions[r.corners.x]);
+    r.p1 = glm::dvec3(scene_.positions[r.corners.y]);
+    r.p2 = glm::dvec3(scene_.positions[r.corners.z]);
+    r.ng = triangleFaceNormal(scene_, instance, triangle);
+    r.ngF = glm::vec3(r.ng);
+    r.authored = r.inst->normals == NormalSource::Authored;
+    r.n0 = r.authored ? scene_.normals[r.corners.x] : glm::vec3(0.0f);
+    r.n1 = r.authored ? scene_.normals[r.corners.y] : glm::vec3(0.0f);
+    r.n2 = r.authored ? scene_.normals[r.corners.z] : glm::vec3(0.0f);
+  }
+
+  // Fills the lanes from `used` to a whole number of vectors with a
+  // harmless surface (unit normals, no light, no colour), never read back.
+  void padLanes() {
+    LaneBlock& b = block_;
+    b.lanes = (b.used + vectorLanes_ - 1) / vectorLanes_ * vectorLanes_;
+    for (size_t i = b.used; i < b.lanes; ++i) {
+      b.dirX[i] = b.dirY[i] = 0.0f;
+      b.dirZ[i] = -1.0f;
+      b.side[i] = 1.0f;
+      b.ngX[i] = b.ngY[i] = 0.0f;
+      b.ngZ[i] = 1.0f;
+      b.authored[i] = 0.0f;
+      b.b0[i] = 1.0f;
+      b.b1[i] = b.b2[i] = 0.0f;
+      b.n0X[i] = b.n0Y[i] = b.n0Z[i] = b.n1X[i] = b.n1Y[i] = b.n1Z[i] = b.n2X[i] = b.n2Y[i] = b.n2Z[i] = 0.0f;
+      b.albedoR[i] = b.albedoG[i] = b.albedoB[i] = 0.0f;
+      b.emitR[i] = b.emitG[i] = b.emitB[i] = 0.0f;
+      b.diffuseWeight[i] = 0.0f;
+      b.alpha[i] = 1.0f;
+      b.toLightX[i] = b.toLightY[i] = 0.0f;
+      b.toLightZ[i] = 1.0f;
+      b.visR[i] = b.visG[i] = b.visB[i] = 1.0f;
+    }
+  }
+
+  const Shader& shader_;
+  const Scene& scene_;
+  const size_t vectorLanes_;
+  std::vector<LaneLight> lights_;
+  TriangleRun run_;
+  LaneBlock block_;
+  glm::vec4* outputs_[kBlock];
+  glm::dvec3 positions_[kBlock];
+  SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback
+};
+
+}  // namespace
+
+void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,
+                      ShadingPath path) {
+  if (path == ShadingPath::Reference || shader.options().referenceShading) {
+    for (size_t i = 0; i < count; ++i) colors[i] = shadeReference(shader, hits[i]);
+    return;
+  }
+  // Built at the first lane: a batch of scalar-path hits (a BLEND layer)
+  // needs none of it.
+  std::optional<BlockShader> block;
+  for (size_t i = 0; i < count; ++i) {
+    const ShadeHit& h = hits[i];
+    const Material& m = shader.scene().materialOf(h.instance);
+    if (needsScalarShade(shader, m)) {
+      colors[i] = shadeReference(shader, h);
+      continue;
+    }
+    if (!block) block.emplace(shader);
+    block->add(h, m, &colors[i]);
+    if (block->full()) block->run();
+  }
+  if (block) block->run();
+}
+
+const char* shadingKernelTarget() {
+  // The target HWY_DYNAMIC_DISPATCH picks: the best one compiled and supported.
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  return targets.empty() ? "none" : hwy::TargetName(targets.front());
+}
+
+}  // namespace rastray
+
+#endif  // HWY_ONCE

@@ -1,0 +1,330 @@
+// The shading kernel (common/shading_kernel.h) against its double
+// reference (Shader::shade): the stated error bound on the bundled and
+// stiff scenes, lane independence (a hit's bits do not depend on its batch),
+// the same bits on every compiled SIMD target, and the lanes that must take
+// the scalar path (tracing materials, BLEND) giving the reference's bits.
+#include "common/shading_kernel.h"
+
+#include <gtest/gtest.h>
+
+#include <hwy/targets.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "common/analysis.h"
+#include "common/gltf/loader.h"
+#include "common/shading.h"
+#include "common/surface.h"
+
+namespace rastray {
+namespace {
+
+// The nearest hit along `ray`, by brute force over every triangle (double,
+// inside test with no tolerance): the test's own renderer.
+bool nearestHit(const Scene& scene, const Ray& ray, SampleHit* out) {
+  double best = std::numeric_limits<double>::infinity();
+  bool found = false;
+  for (uint32_t i = 0; i < scene.instances.size(); ++i)
+    for (uint32_t t = 0; t < scene.instances[i].triangleCount; ++t) {
+      double th;
+      glm::dvec2 b;
+      if (!intersectTrianglePlane(scene, i, t, ray, &th, &b)) continue;
+      if (!(th > 0.0) || th >= best || b.x < 0.0 || b.y < 0.0 || b.x + b.y > 1.0) continue;
+      best = th;
+      *out = SampleHit{i, t, float(th * ray.depthPerT), float(b.x), float(b.y)};
+      found = true;
+    }
+  return found;
+}
+
+// Up to `wanted` primary hits on a grid over the image (fewer on large
+// scenes: the brute force stays under ~2·10⁷ triangle tests).
+std::vector<ShadeHit> primaryHits(const Scene& scene, const Camera& camera, int wanted) {
+  const double triangles = double(std::max<size_t>(1, scene.triangleCount()));
+  const int rays = int(std::clamp(2e7 / triangles, 64.0, double(wanted)));
+  const int side = std::max(2, int(std::sqrt(double(rays))));
+  std::vector<ShadeHit> hits;
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      const glm::dvec2 image((x + 0.37) * camera.width / side, (y + 0.61) * camera.height / side);
+      const Ray ray = camera.primaryRay(image);
+      SampleHit hit;
+      if (nearestHit(scene, ray, &hit)) hits.push_back(refinePrimaryHit(scene, ray, hit, image));
+    }
+  return hits;
+}
+
+// Stands in for shadow rays: a fixed coloured transmittance, so the
+// kernel's visibility callback path is exercised.
+class TintedVisibility : public LightVisibility {
+ public:
+  glm::vec3 transmittance(const SurfacePoint&, int lightIndex, const glm::dvec3&, double) const override {
+    return lightIndex % 2 == 0 ? glm::vec3(0.5f, 0.25f, 1.0f) : glm::vec3(1.0f, 0.0f, 0.75f);
+  }
+};
+
+// Mirrors and glass see a constant colour.
+class ConstantTracer : public SecondaryRayTracer {
+ public:
+  glm::vec3 radiance(const SurfacePoint&, const glm::dvec3&, RayKind, int, float) const override {
+    return {0.25f, 0.5f, 0.75f};
+  }
+};
+
+bool sameBits(const glm::vec4& a, const glm::vec4& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// The bound stated in common/shading_kernel.h: per channel of the
+// premultiplied colour, relative to max(1, |reference|).
+constexpr float kRelativeBound = 1e-6f;
+
+struct Comparison {
+  size_t hits = 0, beyond = 0;
+  float worst = 0.0f;  // largest error within the bound's scale, over the lanes inside it
+};
+
+Comparison compareToReference(const Shader& shader, const std::vector<ShadeHit>& hits) {
+  std::vector<glm::vec4> kernel(hits.size()), reference(hits.size());
+  shadePrimaryHits(shader, hits.data(), hits.size(), kernel.data(), ShadingPath::Kernel);
+  shadePrimaryHits(shader, hits.data(), hits.size(), reference.data(), ShadingPath::Reference);
+  Comparison c;
+  c.hits = hits.size();
+  for (size_t i = 0; i < hits.size(); ++i) {
+    float error = 0.0f;
+    for (int ch = 0; ch < 4; ++ch) {
+      const float r = reference[i][ch], k = kernel[i][ch];
+      error = std::max(error, std::abs(k - r) / std::max(1.0f, std::abs(r)));
+      if (std::isnan(k) != std::isnan(r)) error = std::numeric_limits<float>::infinity();
+    }
+    if (error > kRelativeBound)
+      ++c.beyond;
+    else
+      c.worst = std::max(c.worst, error);
+  }
+  return c;
+}
+
+std::vector<std::string> boundScenes() {
+  return {"cornell-box.gltf",
+          "textured-plane.gltf",
+          "three-triangles.gltf",
+          "vertex-colors.gltf",
+          "interpenetrating.gltf",
+          "cyclic-overlap.gltf",
+          "stiff/far-node-1e6.gltf",
+          "stiff/far-node-1e7.gltf",
+          "stiff/far-baked-1e6.gltf",
+          "stiff/grazing-lit-89.9.gltf",
+          "stiff/grazing-textured-89.9.gltf",
+          "stiff/scale-1e-4.gltf",
+          "stiff/scale-1e4.gltf",
+          "stiff/sliver-fan-aspect-1e6.gltf",
+          "stiff/degenerate.gltf"};
+}
+
+// The stated bound, with and without a visibility callback: every lane
+// within it but for decision flips at a threshold (n·l, n·d within a float
+// rounding of 0), at most 1 in 1000 lanes.
+TEST(ShadingKernel, FloatLanesStayWithinTheStatedBoundOfTheDoubleReference) {
+  const TintedVisibility tinted;
+  for (const std::string& name : boundScenes()) {
+    SCOPED_TRACE(name);
+    const Scene scene = loadScene(std::string(RASTRAY_SCENES) + "/" + name);
+    const SceneAnalysis analysis = analyzeScene(scene);
+    const Camera camera = makeCamera(scene, {}, 160, 120);
+    const std::vector<ShadeHit> hits = primaryHits(scene, camera, 4096);
+    ASSERT_GT(hits.size(), 0u);
+    for (const LightVisibility* visibility :
+         {static_cast<const LightVisibility*>(nullptr), static_cast<const LightVisibility*>(&tinted)}) {
+      const Shader shader(scene, analysis, camera, {}, visibility, nullptr);
+      const Comparison c = compareToReference(shader, hits);
+      std::printf("%-36s %-10s %5zu hits, worst %.2e, beyond the bound %zu\n", name.c_str(),
+                  visibility ? "tinted" : "unshadowed", c.hits, double(c.worst), c.beyond);
+      EXPECT_LE(c.beyond * 1000, c.hits) << c.beyond << " of " << c.hits << " lanes beyond the bound";
+      EXPECT_LE(c.worst, kRelativeBound);
+    }
+  }
+}
+
+// The kernel is not the reference: on a lit scene some lane differs, so
+// the comparisons above and the switch below compare two paths.
+TEST(ShadingKernel, ReferenceShadingOptionSwitchesEveryHitToTheReference) {
+  const Scene scene = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
+  const SceneAnalysis analysis = analyzeScene(scene);
+  const Camera camera = makeCamera(scene, {}, 64, 48);
+  const std::vector<ShadeHit> hits = primaryHits(scene, camera, 1024);
+  ShadingOptions options;
+  const Shader kernelShader(scene, analysis, camera, options, nullptr, nullptr);
+  options.referenceShading = true;
+  const Shader referenceShader(scene, analysis, camera, options, nullptr, nullptr);
+  std::vector<glm::vec4> kernel(hits.size()), forced(hits.size()), reference(hits.size());
+  shadePrimaryHits(kernelShader, hits.data(), hits.size(), kernel.data(), ShadingPath::Kernel);
+  shadePrimaryHits(referenceShader, hits.data(), hits.size(), forced.data(), ShadingPath::Kernel);
+  shadePrimaryHits(kernelShader, hits.data(), hits.size(), reference.data(), ShadingPath::Reference);
+  size_t differ = 0;
+  for (size_t i = 0; i < hits.size(); ++i) {
+    EXPECT_TRUE(sameBits(forced[i], reference[i])) << i;
+    differ += sameBits(kernel[i], reference[i]) ? 0 : 1;
+  }
+  EXPECT_GT(differ, 0u);
+}
+
+// The reference path is Shader::shade on surfacePointOnRay's point, bit
+// for bit: what the renderers did before the kernel.
+TEST(ShadingKernel, ReferencePathIsShaderShadeOnTheRefinedPoint) {
+  const Scene scene = loadScene(std::string(RASTRAY_SCENES) + "/textured-plane.gltf");
+  const SceneAnalysis analysis = analyzeScene(scene);
+  const Camera camera = makeCamera(scene, {}, 64, 48);
+  const Shader shader(scene, analysis, camera, {}, nullptr, nullptr);
+  for (int y = 0; y < 48; y += 5)
+    for (int x = 0; x < 64; x += 5) {
+      const glm::dvec2 image(x + 0.5, y + 0.5);
+      const Ray ray = camera.primaryRay(image);
+      SampleHit hit;
+      if (!nearestHit(scene, ray, &hit)) continue;
+      const SurfacePoint p = surfacePointOnRay(scene, ray, hit);
+      const glm::vec4 expected = shader.shade(p, ray.direction, pixelFootprint(scene, camera, p, image));
+      const ShadeHit h = refinePrimaryHit(scene, ray, hit, image);
+      EXPECT_EQ(h.b1, p.b1);
+      EXPECT_EQ(h.b2, p.b2);
+      glm::vec4 c;
+      shadePrimaryHits(shader, &h, 1, &c, ShadingPath::Reference);
+      EXPECT_TRUE(sameBits(c, expected)) << x << ", " << y;
+    }
+}
+
+// Lane independence: each hit shaded alone, in batches of several sizes
+// and in a shuffled order gives the same bits.
+TEST(ShadingKernel, AHitsColourDoesNotDependOnItsBatch) {
+  const TintedVisibility tinted;
+  for (const char* name : {"cornell-box.gltf", "textured-plane.gltf", "stiff/far-node-1e6.gltf"}) {
+    SCOPED_TRACE(name);
+    const Scene scene = loadScene(std::string(RASTRAY_SCENES) + "/" + name);
+    const Camera camera = makeCamera(scene, {}, 64, 48);
+    const Shader shader(scene, analyzeScene(scene), camera, {}, &tinted, nullptr);
+    std::vector<ShadeHit> hits = primaryHits(scene, camera, 1024);
+    ASSERT_GT(hits.size(), 100u);
+    std::vector<glm::vec4> alone(hits.size());
+    for (size_t i = 0; i < hits.size(); ++i)
+      shadePrimaryHits(shader, &hits[i], 1, &alone[i], ShadingPath::Kernel);
+    for (size_t batch : {size_t(3), size_t(17), size_t(64), size_t(100), hits.size()}) {
+      std::vector<glm::vec4> batched(hits.size());
+      for (size_t first = 0; first < hits.size(); first += batch)
+        shadePrimaryHits(shader, &hits[first], std::min(batch, hits.size() - first), &batched[first],
+                         ShadingPath::Kernel);
+      for (size_t i = 0; i < hits.size(); ++i)
+        EXPECT_TRUE(sameBits(batched[i], alone[i])) << batch << " " << i;
+    }
+    std::vector<size_t> order(hits.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::shuffle(order.begin(), order.end(), std::mt19937(7));
+    std::vector<ShadeHit> shuffled;
+    for (size_t i : order) shuffled.push_back(hits[i]);
+    std::vector<glm::vec4> colors(hits.size());
+    shadePrimaryHits(shader, shuffled.data(), shuffled.size(), colors.data(), ShadingPath::Kernel);
+    for (size_t k = 0; k < order.size(); ++k) EXPECT_TRUE(sameBits(colors[k], alone[order[k]])) << k;
+  }
+}
+
+// Every SIMD target compiled in and supported here gives the same bits
+// (only IEEE-exact operations, no contraction): the colour does not depend
+// on the machine's vector width.
+TEST(ShadingKernel, EverySimdTargetGivesTheSameBits) {
+  const TintedVisibility tinted;
+  const Scene scene = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
+  const Camera camera = makeCamera(scene, {}, 64, 48);
+  const std::vector<ShadeHit> hits = primaryHits(scene, camera, 1024);
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  ASSERT_GE(targets.size(), 1u);
+  std::vector<std::vector<glm::vec4>> colors;
+  for (const bool lit : {false, true}) {
+    const Shader shader(scene, analyzeScene(scene), camera, {}, lit ? &tinted : nullptr, nullptr);
+    std::vector<glm::vec4> first;
+    for (int64_t target : targets) {
+      SCOPED_TRACE(hwy::TargetName(target));
+      hwy::SetSupportedTargetsForTest(target);
+      std::vector<glm::vec4> c(hits.size());
+      shadePrimaryHits(shader, hits.data(), hits.size(), c.data(), ShadingPath::Kernel);
+      if (first.empty()) first = c;
+      for (size_t i = 0; i < hits.size(); ++i) EXPECT_TRUE(sameBits(c[i], first[i])) << i;
+    }
+    hwy::SetSupportedTargetsForTest(0);
+  }
+  std::printf("shading kernel targets tested: %zu, running: %s\n", targets.size(), shadingKernelTarget());
+}
+
+// One triangle in the z = 0 plane facing +Z, with a material.
+Scene triangleScene(const Material& m) {
+  Scene s;
+  s.positions = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+  s.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+  s.texcoords = {{0, 0}, {1, 0}, {0, 1}};
+  s.triangles = {{0, 1, 2}};
+  Instance inst;
+  inst.vertexCount = 3;
+  inst.triangleCount = 1;
+  s.instances.push_back(inst);
+  s.materials.push_back(m);
+  s.bounds.extend({-1, -1, 0});
+  s.bounds.extend({1, 1, 0});
+  Light l;
+  l.position = {0.3, 0.2, 2};
+  l.intensity = 4.0f;
+  s.lights.push_back(l);
+  return s;
+}
+
+// Lanes whose material traces secondary rays (with a tracer) or is BLEND
+// take Shader::shade whole: the reference's bits. Without a tracer a
+// mirror is shaded in the lanes (its mirror part black, as the reference).
+TEST(ShadingKernel, TracingAndBlendMaterialsTakeTheScalarPath) {
+  Material mirror;
+  mirror.metallic = 1.0f;
+  mirror.roughness = 0.25f;
+  Material glass;
+  glass.metallic = 0.0f;
+  glass.transmission = 0.8f;
+  Material blend;
+  blend.metallic = 0.0f;
+  blend.alphaMode = AlphaMode::Blend;
+  blend.baseColorFactor = {1.0f, 0.5f, 0.25f, 0.4f};
+  const ConstantTracer tracer;
+  for (const Material& m : {mirror, glass, blend}) {
+    const Scene scene = triangleScene(m);
+    const Camera camera = makeCamera(scene, {}, 16, 16);
+    const Shader shader(scene, analyzeScene(scene), camera, {}, nullptr, &tracer);
+    std::vector<ShadeHit> hits;
+    for (int k = 0; k < 20; ++k) {
+      ShadeHit h;
+      h.instance = h.triangle = 0;
+      h.b1 = 0.05f * float(k % 10);
+      h.b2 = 0.04f * float(k / 2);
+      h.direction = glm::normalize(glm::dvec3(0.01 * k, -0.02 * k, -1.0));
+      hits.push_back(h);
+    }
+    std::vector<glm::vec4> kernel(hits.size()), reference(hits.size());
+    shadePrimaryHits(shader, hits.data(), hits.size(), kernel.data(), ShadingPath::Kernel);
+    shadePrimaryHits(shader, hits.data(), hits.size(), reference.data(), ShadingPath::Reference);
+    for (size_t i = 0; i < hits.size(); ++i) EXPECT_TRUE(sameBits(kernel[i], reference[i])) << i;
+  }
+  // No tracer: the mirror goes through the lanes, within the bound.
+  const Scene scene = triangleScene(mirror);
+  const Camera camera = makeCamera(scene, {}, 16, 16);
+  const Shader shader(scene, analyzeScene(scene), camera, {}, nullptr, nullptr);
+  ShadeHit h;
+  h.instance = h.triangle = 0;
+  h.b1 = h.b2 = 0.3f;
+  glm::vec4 kernel, reference;
+  shadePrimaryHits(shader, &h, 1, &kernel, ShadingPath::Kernel);
+  shadePrimaryHits(shader, &h, 1, &reference, ShadingPath::Reference);
+  EXPECT_GT(reference.r, 0.0f);
+  EXPECT_NEAR(kernel.r, reference.r, kRelativeBound * std::max(1.0f, reference.r));
+}
+
+}  // namespace
+}  // namespace rastray
