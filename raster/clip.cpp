@@ -58,20 +58,22 @@ ClipVertex split(const ClipVertex& a, const ClipVertex& b, double da, double db)
 
 }  // namespace
 
+uint8_t outsidePlanes(const ClipSpace& space, const glm::dvec4& v) {
+  uint8_t mask = 0;
+  for (int p = 0; p < kPlaneCount; ++p)
+    if (!(planeValue(space, p, v) >= 0.0)) mask |= uint8_t(1u << p);  // NaN counts as outside
+  return mask;
+}
+
 ClipResult clipTriangle(const ClipSpace& space, const glm::dvec4 v[3]) {
   ClipResult r;
-  double value[3][kPlaneCount];
-  int outsideMask = 0;  // planes with a vertex outside
-  for (int i = 0; i < 3; ++i)
-    for (int p = 0; p < kPlaneCount; ++p) {
-      value[i][p] = planeValue(space, p, v[i]);
-      if (!(value[i][p] >= 0.0)) outsideMask |= 1 << p;
-    }
-  for (int p = 0; p < kPlaneCount; ++p)
-    if (!(value[0][p] >= 0.0) && !(value[1][p] >= 0.0) && !(value[2][p] >= 0.0)) {
-      r.outcome = ClipOutcome::Outside;
-      return r;
-    }
+  const uint8_t mask[3] = {outsidePlanes(space, v[0]), outsidePlanes(space, v[1]),
+                           outsidePlanes(space, v[2])};
+  if (mask[0] & mask[1] & mask[2]) {  // all three beyond one plane
+    r.outcome = ClipOutcome::Outside;
+    return r;
+  }
+  const int outsideMask = mask[0] | mask[1] | mask[2];  // planes with a vertex outside
   r.count = 3;
   for (int i = 0; i < 3; ++i) {
     r.vertices[i].position = v[i];

@@ -48,6 +48,10 @@ struct ClipSpace {
   glm::dvec2 guard{1.0};  // guard band half extents in NDC (>= 1)
 
   ClipVertex project(const glm::dvec3& view, const glm::dvec3& bary) const;
+  // A world point's clip position: view transform in double, then project.
+  glm::dvec4 clipOf(const glm::dvec3& world) const {
+    return project(glm::dvec3(viewFromWorld * glm::dvec4(world, 1.0)), glm::dvec3(0.0)).position;
+  }
   // Image position (pixels, y down) of a clip vertex with w > 0.
   glm::dvec2 imageOf(const glm::dvec4& clip) const {
     return {(clip.x / clip.w + 1.0) * 0.5 * width, (1.0 - clip.y / clip.w) * 0.5 * height};
@@ -67,6 +71,12 @@ struct ClipResult {
   bool guardClipped = false;
   ClipVertex vertices[kMaxClipVertices];
 };
+
+// Bit p set when clip position v lies outside plane p (bit 0 near, 1 far,
+// 2–5 the guard band's +x, −x, +y, −y sides): a pure function of the vertex, so a vertex shared by many
+// triangles is classified once. A triangle is trivially outside when its three masks share a bit, and needs
+// no clipping when their union is 0.
+uint8_t outsidePlanes(const ClipSpace& space, const glm::dvec4& v);
 
 // Clips the triangle with clip-space positions v[0..2] (bary = unit
 // vectors). Trivially outside (all vertices beyond one plane): Outside.

@@ -99,8 +99,13 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   // Transform, clip, set up.
   auto start = Clock::now();
   SetupCounters sc;
+  TriangleFilter filter;
+  filter.blend = analysis.transparency;
+  // Setups that cover no sample change no sample; the wireframe still
+  // draws their edges, and a pixel trace reports their coverage tests.
+  filter.keepSampleless = options.wireframe || options.trace.sink != nullptr;
   const std::vector<TriangleSetup> setups =
-      prepareTriangles(scene, space, grid, depth, options.cull, {true, analysis.transparency}, &sc);
+      prepareTriangles(scene, space, grid, depth, options.cull, filter, &sc);
   out.timings.emplace_back("raster.setup", secondsSince(start));
 
   // Bin: OPAQUE and MASK apart from BLEND (built only when the scene has BLEND).

@@ -64,6 +64,7 @@ void reportCounters(const SetupCounters& setup, uint64_t trianglesSetup, const T
   k.set("raster.degenerate", setup.degenerate);
   k.set("raster.culled", setup.culled);
   k.set("raster.outside", setup.outside);
+  k.set("raster.no_sample", setup.noSample);
   k.set("raster.clipped", setup.clipped);
   k.set("raster.guard_band_clipped", setup.guardBandClipped);
   k.set("raster.triangles_from_clipping", setup.fromClipping);

@@ -13,6 +13,7 @@
 #include "common/parallel.h"
 #include "common/sampling.h"
 #include "raster/depth.h"
+#include "raster/huge_pages.h"
 
 namespace rastray {
 
@@ -65,23 +66,19 @@ Plane makePlane(const double x[3], const double y[3], const double a[3], double 
 
 int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
-}  // namespace
+// An image coordinate (pixels) on the fixed-point grid. Clamping only moves
+// vertices that the guard-band clip left a rounding error beyond it; inside
+// the range it is the identity.
+int64_t snapUnits(double c, double U) {
+  const double s = std::round(c * U);
+  return int64_t(std::clamp(s, -double(kMaxCoordinateUnits), double(kMaxCoordinateUnits)));
+}
 
-SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& ds,
-                           const ClipVertex v[3], CullMode cull, TriangleSetup* t) {
-  const double U = double(grid.unitsPerPixel);
-  glm::dvec2 image[3];  // unsnapped image positions, reused by the planes
-  glm::i64vec2 snapped[3];
-  for (int i = 0; i < 3; ++i) {
-    image[i] = space.imageOf(v[i].position);
-    // Clamping only moves vertices that the guard-band clip left a rounding
-    // error beyond it; inside the range it is the identity.
-    const auto snap = [&](double c) {
-      const double s = std::round(c * U);
-      return int64_t(std::clamp(s, -double(kMaxCoordinateUnits), double(kMaxCoordinateUnits)));
-    };
-    snapped[i] = {snap(image[i].x), snap(image[i].y)};
-  }
+// The integer half of setup, from the snapped vertices: area, facing,
+// culling, pixel bounds, the vertex order of positive area (`order`) and
+// the edge functions (their `original` flags are left false).
+SetupOutcome setupEdges(const ClipSpace& space, const SampleGrid& grid, const glm::i64vec2 snapped[3],
+                        CullMode cull, int order[3], TriangleSetup* t) {
   const int64_t area2 = (snapped[1].x - snapped[0].x) * (snapped[2].y - snapped[0].y) -
                         (snapped[1].y - snapped[0].y) * (snapped[2].x - snapped[0].x);
   if (area2 == 0) return SetupOutcome::Degenerate;  // zero area after snapping: covers nothing
@@ -102,13 +99,11 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
   if (t->pixelMin.x > t->pixelMax.x || t->pixelMin.y > t->pixelMax.y) return SetupOutcome::Offscreen;
 
   // Reorder to positive area: swap vertices 1 and 2 of front faces.
-  const int order[3] = {0, area2 > 0 ? 1 : 2, area2 > 0 ? 2 : 1};
-  const ClipVertex* cv[3];
-  for (int i = 0; i < 3; ++i) {
-    // |X|, |Y| <= 2^29 after the clamp: exact in int32.
-    t->vertex[i] = glm::ivec2(snapped[order[i]]);
-    cv[i] = &v[order[i]];
-  }
+  order[0] = 0;
+  order[1] = area2 > 0 ? 1 : 2;
+  order[2] = area2 > 0 ? 2 : 1;
+  // |X|, |Y| <= 2^29 after the clamp: exact in int32.
+  for (int i = 0; i < 3; ++i) t->vertex[i] = glm::ivec2(snapped[order[i]]);
   for (int i = 0; i < 3; ++i) {
     const int j = (i + 1) % 3;
     EdgeFunction& e = t->edge[i];
@@ -120,8 +115,21 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
     e.topLeft = (dy == 0 && dx > 0) || dy < 0;
     e.bias = e.topLeft ? 0 : -1;
     e.original = false;
+  }
+  return SetupOutcome::Ok;
+}
+
+// The double half of setup, after setupEdges: which edges are the original
+// triangle's, and the planes from the unsnapped image positions `image`
+// (of v, in v's order).
+void setupPlanes(const SampleGrid& grid, const DepthSettings& ds, const ClipVertex v[3],
+                 const glm::dvec2 image[3], const int order[3], TriangleSetup* t) {
+  const double U = double(grid.unitsPerPixel);
+  const ClipVertex* cv[3] = {&v[order[0]], &v[order[1]], &v[order[2]]};
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
     for (int k = 0; k < 3; ++k)
-      if (cv[i]->bary[k] == 0.0 && cv[j]->bary[k] == 0.0) e.original = true;
+      if (cv[i]->bary[k] == 0.0 && cv[j]->bary[k] == 0.0) t->edge[i].original = true;
   }
 
   // Planes over image pixels from the unsnapped positions: depth and
@@ -139,7 +147,12 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
       x[i] = double(t->vertex[i].x) / U;
       y[i] = double(t->vertex[i].y) / U;
     }
-    areaPixels = double(std::abs(area2)) / (U * U);
+    // Twice the snapped area in units², positive in the reordered vertices
+    // (setupEdges): exact in int64.
+    const int64_t area2 =
+        (int64_t(t->vertex[1].x) - t->vertex[0].x) * (int64_t(t->vertex[2].y) - t->vertex[0].y) -
+        (int64_t(t->vertex[1].y) - t->vertex[0].y) * (int64_t(t->vertex[2].x) - t->vertex[0].x);
+    areaPixels = double(area2) / (U * U);
   }
   for (int i = 0; i < 3; ++i) {
     const glm::dvec4& p = cv[i]->position;
@@ -158,7 +171,40 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
                                       std::max({z[0], z[1], z[2]}));
   // Positive offsets push away from the viewer: towards 1 conventionally, 0 reversed.
   t->depth.v0 += isReversed(ds.format) ? -offset : offset;
+}
+
+}  // namespace
+
+SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& ds,
+                           const ClipVertex v[3], CullMode cull, TriangleSetup* t) {
+  const double U = double(grid.unitsPerPixel);
+  glm::dvec2 image[3];  // unsnapped image positions, reused by the planes
+  glm::i64vec2 snapped[3];
+  for (int i = 0; i < 3; ++i) {
+    image[i] = space.imageOf(v[i].position);
+    snapped[i] = {snapUnits(image[i].x, U), snapUnits(image[i].y, U)};
+  }
+  int order[3];
+  const SetupOutcome o = setupEdges(space, grid, snapped, cull, order, t);
+  if (o != SetupOutcome::Ok) return o;
+  setupPlanes(grid, ds, v, image, order, t);
   return SetupOutcome::Ok;
+}
+
+bool mayCoverSample(const TriangleSetup& t, const SampleGrid& grid) {
+  const int64_t w = int64_t(t.pixelMax.x) - t.pixelMin.x + 1, h = int64_t(t.pixelMax.y) - t.pixelMin.y + 1;
+  if (w * h * grid.spp > kSampleSearchLimit) return true;
+  const int64_t U = grid.unitsPerPixel;
+  for (int py = t.pixelMin.y; py <= t.pixelMax.y; ++py)
+    for (int px = t.pixelMin.x; px <= t.pixelMax.x; ++px)
+      for (const glm::i64vec2& o : grid.offsets) {
+        // Inside the image: within setup.h's exact int64 range.
+        const int64_t X = int64_t(px) * U + o.x, Y = int64_t(py) * U + o.y;
+        if (t.edge[0].at(X, Y) + t.edge[0].bias >= 0 && t.edge[1].at(X, Y) + t.edge[1].bias >= 0 &&
+            t.edge[2].at(X, Y) + t.edge[2].bias >= 0)
+          return true;
+      }
+  return false;
 }
 
 namespace {
@@ -183,92 +229,243 @@ void add(const SetupCounters& from, SetupCounters* to) {
   to->clipped += from.clipped;
   to->fromClipping += from.fromClipping;
   to->guardBandClipped += from.guardBandClipped;
+  to->noSample += from.noSample;
 }
 
-// Transform, clip and set up one chunk's triangles in order.
-void setupChunk(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
-                const DepthSettings& depth, CullMode cull, const TriangleFilter& filter,
-                const SetupChunk& chunk, ChunkOutput* out) {
-  const Instance& inst = scene.instances[chunk.instance];
-  const CullMode instanceCull = scene.materials[inst.material].doubleSided ? CullMode::None : cull;
+// What the frame's setup shares across chunks.
+struct SetupContext {
+  const Scene& scene;
+  const ClipSpace& space;
+  const SampleGrid& grid;
+  const DepthSettings& depth;
+  CullMode cull;
+  const TriangleFilter& filter;
+};
+
+// The reference steps for one triangle of nonzero world area whose world
+// positions are p: transform, clip, set up each fan piece, keep those that
+// may cover a sample; a triangle that keeps no piece is counted by why.
+void setupClipped(const SetupContext& c, CullMode instanceCull, uint32_t instance, uint32_t triangle,
+                  const glm::dvec3 p[3], ChunkOutput* out) {
+  SetupCounters& n = out->counters;
+  const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
+  const ClipResult cr = clipTriangle(c.space, clip);
+  if (cr.outcome == ClipOutcome::Outside) {
+    ++n.outside;
+    return;
+  }
+  if (cr.outcome == ClipOutcome::Clipped) {
+    ++n.clipped;
+    if (cr.guardClipped) ++n.guardBandClipped;
+    n.fromClipping += uint64_t(cr.count - 2);
+  }
+  TriangleSetup t;
+  t.instance = instance;
+  t.triangle = triangle;
+  t.fromClipping = cr.outcome == ClipOutcome::Clipped;
+  t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
+  bool culled = false, visible = false, degenerate = false, sampleless = false;
+  for (int i = 1; i + 1 < cr.count; ++i) {
+    const ClipVertex fan[3] = {cr.vertices[0], cr.vertices[i], cr.vertices[i + 1]};
+    const SetupOutcome o = setupTriangle(c.space, c.grid, c.depth, fan, instanceCull, &t);
+    if (o == SetupOutcome::Culled) culled = true;
+    if (o == SetupOutcome::Degenerate) degenerate = true;
+    if (o != SetupOutcome::Ok) continue;
+    if (!c.filter.keepSampleless && !mayCoverSample(t, c.grid)) {
+      sampleless = true;
+      continue;
+    }
+    visible = true;
+    out->setups.push_back(t);
+  }
+  if (!visible) {
+    if (culled)
+      ++n.culled;
+    else if (degenerate && cr.count == 3)
+      ++n.degenerate;  // zero area after snapping: sub-pixel sliver or edge-on
+    else if (sampleless)
+      ++n.noSample;
+    else
+      ++n.outside;
+  }
+}
+
+// Per vertex of the scene (absolute index): the planes its clip position
+// lies outside (clip.h's outsidePlanes) and, where that is none, its
+// snapped image position, exactly as setupTriangle snaps it. Allocated
+// without initialising: only the selected instances' vertices are written
+// and read.
+struct VertexCodes {
+  struct Snapped {
+    int32_t x, y;  // |X|, |Y| <= 2^29 (snapUnits clamps)
+  };
+  std::unique_ptr<uint8_t[]> outside;
+  std::unique_ptr<Snapped[]> snapped;
+};
+
+// Loads a triangle's world positions; false when its world area is zero
+// (isDegenerate in common/scene.h on the positions already loaded).
+bool loadTriangle(const Scene& scene, const glm::uvec3& idx, glm::dvec3 p[3]) {
+  p[0] = glm::dvec3(scene.positions[idx.x]);
+  p[1] = glm::dvec3(scene.positions[idx.y]);
+  p[2] = glm::dvec3(scene.positions[idx.z]);
+  return glm::cross(p[1] - p[0], p[2] - p[0]) != glm::dvec3(0.0);
+}
+
+// The reference: transform, clip and set up one chunk's triangles in order.
+void setupChunkReference(const SetupContext& c, const SetupChunk& chunk, ChunkOutput* out) {
+  const Instance& inst = c.scene.instances[chunk.instance];
+  const CullMode instanceCull = c.scene.materials[inst.material].doubleSided ? CullMode::None : c.cull;
   SetupCounters& n = out->counters;
   out->setups.reserve(chunk.count);  // one piece per triangle unless clipping splits it
   for (uint32_t k = chunk.first; k < chunk.first + chunk.count; ++k) {
-    if (filter.candidates && !((*filter.candidates)[inst.firstTriangle + k] & filter.candidateBit)) continue;
+    if (c.filter.candidates && !((*c.filter.candidates)[inst.firstTriangle + k] & c.filter.candidateBit))
+      continue;
     ++n.trianglesIn;
-    const glm::uvec3 idx = scene.triangles[inst.firstTriangle + k];
-    const glm::dvec3 p[3] = {glm::dvec3(scene.positions[idx.x]), glm::dvec3(scene.positions[idx.y]),
-                             glm::dvec3(scene.positions[idx.z])};
-    // isDegenerate (common/scene.h) on the positions already loaded.
-    if (glm::cross(p[1] - p[0], p[2] - p[0]) == glm::dvec3(0.0)) {
+    glm::dvec3 p[3];
+    if (!loadTriangle(c.scene, c.scene.triangles[inst.firstTriangle + k], p)) {
       ++n.degenerate;  // SPEC §1: zero world area covers nothing
       continue;
     }
-    glm::dvec4 clip[3];
-    for (int i = 0; i < 3; ++i)
-      clip[i] =
-          space.project(glm::dvec3(space.viewFromWorld * glm::dvec4(p[i], 1.0)), glm::dvec3(0.0)).position;
-    const ClipResult cr = clipTriangle(space, clip);
-    if (cr.outcome == ClipOutcome::Outside) {
+    setupClipped(c, instanceCull, chunk.instance, k, p, out);
+  }
+}
+
+// The same setups and counters as setupChunkReference, from the vertex
+// codes: the outside, degenerate, culling, bounds and sample tests of a
+// triangle that needs no clipping are integer work on its vertices' codes
+// (its clip vertices are its own vertices, so setupTriangle would snap
+// them to the same positions); only a kept triangle is transformed again
+// for its planes.
+void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const SetupChunk& chunk,
+                    ChunkOutput* out) {
+  const Instance& inst = c.scene.instances[chunk.instance];
+  const CullMode instanceCull = c.scene.materials[inst.material].doubleSided ? CullMode::None : c.cull;
+  SetupCounters& n = out->counters;
+  out->setups.reserve(chunk.count / 4);  // most triangles of a dense mesh cover no sample
+  for (uint32_t k = chunk.first; k < chunk.first + chunk.count; ++k) {
+    if (c.filter.candidates && !((*c.filter.candidates)[inst.firstTriangle + k] & c.filter.candidateBit))
+      continue;
+    ++n.trianglesIn;
+    const glm::uvec3 idx = c.scene.triangles[inst.firstTriangle + k];
+    glm::dvec3 p[3];
+    if (!loadTriangle(c.scene, idx, p)) {
+      ++n.degenerate;  // SPEC §1: zero world area covers nothing
+      continue;
+    }
+    // Codes exist for the instance's own vertex range only.
+    const glm::uvec3 local = idx - glm::uvec3(inst.firstVertex);
+    if (local.x >= inst.vertexCount || local.y >= inst.vertexCount || local.z >= inst.vertexCount) {
+      setupClipped(c, instanceCull, chunk.instance, k, p, out);
+      continue;
+    }
+    const uint8_t m0 = codes.outside[idx.x], m1 = codes.outside[idx.y], m2 = codes.outside[idx.z];
+    if (m0 & m1 & m2) {  // clipTriangle's trivial reject
       ++n.outside;
       continue;
     }
-    if (cr.outcome == ClipOutcome::Clipped) {
-      ++n.clipped;
-      if (cr.guardClipped) ++n.guardBandClipped;
-      n.fromClipping += uint64_t(cr.count - 2);
+    if (m0 | m1 | m2) {  // needs clipping
+      setupClipped(c, instanceCull, chunk.instance, k, p, out);
+      continue;
     }
     TriangleSetup t;
     t.instance = chunk.instance;
     t.triangle = k;
-    t.fromClipping = cr.outcome == ClipOutcome::Clipped;
+    t.fromClipping = false;
+    const glm::i64vec2 snapped[3] = {{codes.snapped[idx.x].x, codes.snapped[idx.x].y},
+                                     {codes.snapped[idx.y].x, codes.snapped[idx.y].y},
+                                     {codes.snapped[idx.z].x, codes.snapped[idx.z].y}};
+    int order[3];
+    const SetupOutcome o = setupEdges(c.space, c.grid, snapped, instanceCull, order, &t);
+    if (o == SetupOutcome::Degenerate) {
+      ++n.degenerate;  // zero area after snapping: sub-pixel sliver or edge-on
+      continue;
+    }
+    if (o == SetupOutcome::Culled) {
+      ++n.culled;
+      continue;
+    }
+    if (o == SetupOutcome::Offscreen) {
+      ++n.outside;
+      continue;
+    }
+    if (!c.filter.keepSampleless && !mayCoverSample(t, c.grid)) {
+      ++n.noSample;
+      continue;
+    }
+    const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
     t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
-    bool culled = false, visible = false, degenerate = false;
-    for (int i = 1; i + 1 < cr.count; ++i) {
-      const ClipVertex fan[3] = {cr.vertices[0], cr.vertices[i], cr.vertices[i + 1]};
-      const SetupOutcome o = setupTriangle(space, grid, depth, fan, instanceCull, &t);
-      if (o == SetupOutcome::Culled) culled = true;
-      if (o == SetupOutcome::Degenerate) degenerate = true;
-      if (o != SetupOutcome::Ok) continue;
-      visible = true;
-      out->setups.push_back(t);
-    }
-    if (!visible) {
-      if (culled)
-        ++n.culled;
-      else if (degenerate && cr.count == 3)
-        ++n.degenerate;  // zero area after snapping: sub-pixel sliver or edge-on
-      else
-        ++n.outside;
-    }
+    const ClipVertex v[3] = {
+        {clip[0], glm::dvec3(1, 0, 0)}, {clip[1], glm::dvec3(0, 1, 0)}, {clip[2], glm::dvec3(0, 0, 1)}};
+    const glm::dvec2 image[3] = {c.space.imageOf(clip[0]), c.space.imageOf(clip[1]),
+                                 c.space.imageOf(clip[2])};
+    setupPlanes(c.grid, c.depth, v, image, order, &t);
+    out->setups.push_back(t);
   }
+}
+
+// Fills `codes` for every vertex of the instances the chunks cover, in
+// parallel.
+void computeVertexCodes(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
+                        const std::vector<uint32_t>& instances, VertexCodes* codes) {
+  codes->outside.reset(new uint8_t[scene.positions.size()]);
+  codes->snapped.reset(new VertexCodes::Snapped[scene.positions.size()]);
+  struct Range {
+    size_t begin, end;
+  };
+  std::vector<Range> ranges;
+  constexpr size_t kBlock = 16384;
+  for (uint32_t i : instances) {
+    const Instance& inst = scene.instances[i];
+    const size_t end = std::min(scene.positions.size(), size_t(inst.firstVertex) + inst.vertexCount);
+    for (size_t v = inst.firstVertex; v < end; v += kBlock) ranges.push_back({v, std::min(end, v + kBlock)});
+  }
+  const double U = double(grid.unitsPerPixel);
+  uint8_t* outside = codes->outside.get();
+  VertexCodes::Snapped* snapped = codes->snapped.get();
+  parallelFor(size_t(0), ranges.size(), [&](size_t r) {
+    for (size_t v = ranges[r].begin; v < ranges[r].end; ++v) {
+      const glm::dvec4 clip = space.clipOf(glm::dvec3(scene.positions[v]));
+      const uint8_t mask = outsidePlanes(space, clip);
+      outside[v] = mask;
+      if (mask != 0) continue;  // w may be <= 0: no image position
+      const glm::dvec2 image = space.imageOf(clip);
+      snapped[v] = {int32_t(snapUnits(image.x, U)), int32_t(snapUnits(image.y, U))};
+    }
+  });
 }
 
 }  // namespace
 
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
                                             const SampleGrid& grid, const DepthSettings& depth, CullMode cull,
-                                            TriangleFilter filter, SetupCounters* counters) {
+                                            TriangleFilter filter, SetupCounters* counters, SetupPath path) {
   // Chunks of one instance's triangles, set up in parallel and appended in
   // chunk order by a pipeline: deterministic whatever the scheduling, and
   // only the chunks in flight (a few per thread) exist besides the result,
   // so the frame never holds two copies of its setups.
   constexpr uint32_t kChunk = 2048;
   std::vector<SetupChunk> chunks;
+  std::vector<uint32_t> instances;  // those the filter selects
   size_t inputs = 0;
   for (uint32_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& inst = scene.instances[i];
     const AlphaMode mode = scene.materials[inst.material].alphaMode;
     if (mode == AlphaMode::Blend ? !filter.blend : !filter.opaque) continue;
+    instances.push_back(i);
     for (uint32_t f = 0; f < inst.triangleCount; f += kChunk)
       chunks.push_back({i, f, std::min(kChunk, inst.triangleCount - f)});
     inputs += inst.triangleCount;
   }
+  const SetupContext context{scene, space, grid, depth, cull, filter};
+  VertexCodes codes;
+  if (path == SetupPath::Fast) computeVertexCodes(scene, space, grid, instances, &codes);
   // One setup per input triangle at most, unless clipping splits some: the
   // capacity is reserved once, and pages the setups never reach are never
   // touched (so they cost address space, not memory).
   std::vector<TriangleSetup> setups;
   setups.reserve(inputs);
+  adviseHugePages(setups.data(), setups.capacity() * sizeof(TriangleSetup));
   size_t next = 0, appendedInputs = 0;
   const size_t tokens = 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
   // A chunk's output waits in its slot from the parallel stage to the ordered
@@ -292,7 +489,10 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
     if (c >= chunks.size()) return c;
     auto out = std::make_unique<ChunkOutput>();
     out->inputs = chunks[c].count;
-    setupChunk(scene, space, grid, depth, cull, filter, chunks[c], out.get());
+    if (path == SetupPath::Fast)
+      setupChunkFast(context, codes, chunks[c], out.get());
+    else
+      setupChunkReference(context, chunks[c], out.get());
     outputs[c] = std::move(out);
     tsanRelease(&outputs[c]);
     return c;

@@ -128,6 +128,18 @@ struct DepthSettings {
 
 enum class SetupOutcome { Ok, Degenerate, Culled, Offscreen };  // Offscreen: no pixel of the image
 
+// Pixel bounds of at most this many samples are searched for a covered
+// sample; larger ones are assumed to cover one (mayCoverSample).
+constexpr int kSampleSearchLimit = 64;
+
+// Whether t may cover a sample of the image: false only when its pixel
+// bounds hold at most kSampleSearchLimit samples and none of them passes
+// the three edge tests (E + bias >= 0, coverage.h's rule), so no coverage
+// walk would ever visit a sample of it. Reads only t's edges and pixel
+// bounds. At 10^7 triangles on a 1080p image most triangles cover no
+// sample: they are dropped before their planes are computed or stored.
+bool mayCoverSample(const TriangleSetup& t, const SampleGrid& grid);
+
 // Sets up one clipped triangle (three clip vertices with w > 0).
 // `cull`: which facing to drop (None keeps both).
 SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& depth,
@@ -141,6 +153,7 @@ struct SetupCounters {
   uint64_t clipped = 0;           // needed near/far or guard-band clipping
   uint64_t fromClipping = 0;      // triangles made by clipping (fan pieces)
   uint64_t guardBandClipped = 0;  // of the clipped, those beyond the guard band
+  uint64_t noSample = 0;          // set up but cover no sample (mayCoverSample): not kept
 };
 
 // Which triangles to set up: by material class (Opaque covers OPAQUE and
@@ -151,15 +164,32 @@ struct TriangleFilter {
   bool blend = true;
   const std::vector<uint8_t>* candidates = nullptr;
   uint8_t candidateBit = 0;
+  // Keep the setups that cover no sample (mayCoverSample false). Only what
+  // draws more than samples needs them: the wireframe draws their edges and
+  // a pixel trace reports their coverage tests.
+  bool keepSampleless = false;
 };
+
+// How prepareTriangles works; both give the same setups and counters.
+//   Reference  per triangle: transform its three vertices, clip, set up.
+//   Fast       per vertex first (in parallel): clip position, outside
+//              planes and snapped image position, once per vertex; then
+//              per triangle, integer tests on those (outside, degenerate,
+//              culled, off the image, no sample) before any plane is
+//              computed. Triangles that need clipping take the reference
+//              steps.
+enum class SetupPath { Fast, Reference };
 
 // Transform (world → view in double), clip and set up every triangle of the
 // scene that passes `filter`, in scene order (instance, triangle; clipped
 // pieces in fan order), independently of the thread count. `cull` applies
-// to single-sided materials only. Memory: the result (reserved once for
-// one setup per input triangle) and a few chunks in flight per thread.
+// to single-sided materials only. Memory: the result (capacity reserved
+// once for one setup per input triangle; pages never written cost no
+// memory), a few chunks in flight per thread, and on the fast path 9
+// bytes per vertex of the selected instances until it returns.
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
                                             const SampleGrid& grid, const DepthSettings& depth, CullMode cull,
-                                            TriangleFilter filter, SetupCounters* counters);
+                                            TriangleFilter filter, SetupCounters* counters,
+                                            SetupPath path = SetupPath::Fast);
 
 }  // namespace rastray

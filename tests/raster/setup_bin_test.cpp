@@ -67,7 +67,7 @@ Scene randomScene(uint32_t seed) {
 }
 
 // The serial reference: transform, clip and set up triangle after
-// triangle, pieces in fan order.
+// triangle, pieces in fan order, keeping those that may cover a sample.
 std::vector<TriangleSetup> serialSetups(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
                                         const DepthSettings& ds, CullMode cull) {
   std::vector<TriangleSetup> out;
@@ -92,7 +92,8 @@ std::vector<TriangleSetup> serialSetups(const Scene& scene, const ClipSpace& spa
         t.triangle = k;
         t.fromClipping = cr.outcome == ClipOutcome::Clipped;
         t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
-        if (setupTriangle(space, grid, ds, fan, c, &t) == SetupOutcome::Ok) out.push_back(t);
+        if (setupTriangle(space, grid, ds, fan, c, &t) == SetupOutcome::Ok && mayCoverSample(t, grid))
+          out.push_back(t);
       }
     }
   }
@@ -122,14 +123,16 @@ TEST(ParallelSetup, MatchesTheSerialOrderAtOneAndTwoThreads) {
   const std::vector<TriangleSetup> reference = serialSetups(scene, f.space, f.grid, f.depth, CullMode::Back);
   SetupCounters refCounters;
   size_t clippedPieces = 0;
-  for (size_t threads : {1, 2, 3}) {
+  for (size_t run = 0; run < 6; ++run) {
+    const size_t threads = 1 + run / 2;
+    const SetupPath path = run % 2 == 0 ? SetupPath::Fast : SetupPath::Reference;
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     SetupCounters n;
     const std::vector<TriangleSetup> setups =
-        prepareTriangles(scene, f.space, f.grid, f.depth, CullMode::Back, {}, &n);
+        prepareTriangles(scene, f.space, f.grid, f.depth, CullMode::Back, {}, &n, path);
     ASSERT_EQ(setups.size(), reference.size()) << threads << " threads";
     for (size_t i = 0; i < setups.size(); ++i) expectSameSetup(setups[i], reference[i], i);
-    if (threads == 1) {
+    if (run == 0) {
       refCounters = n;
       for (const TriangleSetup& t : setups) clippedPieces += t.fromClipping;
     }
