@@ -10,7 +10,6 @@ packages=(
   libembree-dev libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenimageio-dev openimageio-tools libopencv-core-dev libopenexr-dev
   libtbb-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libhwy-dev  # Highway: the shading kernel's SIMD lanes with run-time dispatch (common/shading_kernel.cpp)
   chromium  # the real-browser tests (crossval report, `rastray serve` page, headless), which CI must run, not skip
   libhwy-dev  # Highway: portable SIMD with run-time dispatch (shading, resolve, PNG encoding)
   libcpp-httplib-dev  # the HTTP server of `rastray serve`, the browser explorer
