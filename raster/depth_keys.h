@@ -32,8 +32,19 @@ namespace rastray {
 
 // v0 + dx·(x − x0) at the eight columns x = px0 + i + offsetX (i < 8):
 // the column part of Plane::at.
+// double(px0 + i) is double(px0) + i exactly (integers below 2^53), so the
+// SIMD form performs the scalar operations on the same values.
 inline void planeColumnTerms(const Plane& p, int px0, double offsetX, double (&column)[8]) {
+#if defined(__SSE2__)
+  const __m128d x0 = _mm_set1_pd(double(px0)), ox = _mm_set1_pd(offsetX), origin = _mm_set1_pd(p.x0);
+  const __m128d dx = _mm_set1_pd(p.dx), v0 = _mm_set1_pd(p.v0);
+  for (int i = 0; i < 8; i += 2) {
+    const __m128d x = _mm_add_pd(x0, _mm_set_pd(double(i + 1), double(i)));
+    _mm_storeu_pd(column + i, _mm_add_pd(v0, _mm_mul_pd(dx, _mm_sub_pd(_mm_add_pd(x, ox), origin))));
+  }
+#else
   for (int i = 0; i < 8; ++i) column[i] = p.v0 + p.dx * ((double(px0 + i) + offsetX) - p.x0);
+#endif
 }
 
 // dy·(y − y0) at y = py + offsetY: the row part of Plane::at.

@@ -365,8 +365,16 @@ void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::
   RASTRAY_CHECK(grid.spp == 1,
                 "the depth-only pass takes 1 sample per texel, not " + std::to_string(grid.spp));
   const TileRect& rect = rect_;
-  const int width = rect.x1 - rect.x0, height = rect.y1 - rect.y0;
-  for (int j = 0; j < height; ++j) std::fill_n(&keys_[size_t(j) * kTileSize], size_t(width), kClearBiased);
+  const int height = rect.y1 - rect.y0;
+  // Clear the rows in use, whole (GCC 12 does not vectorise loops at -O2:
+  // a scalar fill here cost as much as a sixth of the drawing).
+#if defined(__SSE2__)
+  const __m128i clear = _mm_set1_epi32(kClearBiased);
+  for (size_t i = 0; i < size_t(height) * kTileSize; i += 4)
+    _mm_store_si128(reinterpret_cast<__m128i*>(&keys_[i]), clear);
+#else
+  std::fill_n(keys_, size_t(height) * kTileSize, kClearBiased);
+#endif
   if (path == CoveragePath::Reference) {
     CoverageScratch scratch;
     for (uint32_t index : bin) {
