@@ -1,7 +1,7 @@
 // What the performance peers (rastray_osmesa_peer, rastray_embree_peer)
 // share: the explicit camera of their command line, the scene rebased the
 // way rastray rebases it, and the frame-time lines `rastray bench --peers`
-// reads (app/bench_peers.h).
+// reads (app/bench/bench_peers.h).
 //
 // The camera is given explicitly because the peer must see what rastray
 // sees: the caller resolves it with rastray's makeCamera and passes every

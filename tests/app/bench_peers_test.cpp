@@ -1,9 +1,9 @@
-// The performance peers (app/bench_peers.h, bench/peers/): they run, their
+// The performance peers (app/bench/bench_peers.h, bench/peers/): they run, their
 // frame times are read, and they see what rastray sees: the OSMesa peer's
 // IDs and depth agree with rastray's rasterizer pixel by pixel (same
 // camera, same flattened geometry), the viewer's OBJ holds rastray's
 // vertices and triangles and is exported once. Bad input exits 2.
-#include "app/bench_peers.h"
+#include "app/bench/bench_peers.h"
 
 #include <fcntl.h>
 #include <sys/wait.h>

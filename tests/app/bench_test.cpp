@@ -8,9 +8,9 @@
 #include <regex>
 #include <sstream>
 
-#include "app/bench.h"
-#include "app/csv.h"
-#include "app/stability_measure.h"
+#include "app/bench/bench.h"
+#include "app/report/csv.h"
+#include "app/studies/stability_measure.h"
 #include "tests/app/run_command.h"
 #include "tests/test_files.h"
 
@@ -32,7 +32,7 @@ TEST(BenchSpread, MedianOfOddAndEvenCounts) {
 BenchResult bench(const std::vector<std::string>& args, int frames, int warmup) {
   BenchRequest request;
   request.scenePath = kCornell;
-  request.settings = stability::renderSettingsFrom(args);
+  request.settings = renderSettingsFrom(args);
   request.frames = frames;
   request.warmup = warmup;
   return runBench(request);
@@ -57,7 +57,7 @@ TEST(Bench, EachFrameReportsItsOwnRays) {
 TEST(Bench, RoundsCallBackAfterEachRoundWithTheCamera) {
   BenchRequest request;
   request.scenePath = kCornell;
-  request.settings = stability::renderSettingsFrom({"--renderer", "raytrace", "--size", "24", "16"});
+  request.settings = renderSettingsFrom({"--renderer", "raytrace", "--size", "24", "16"});
   request.frames = 2;
   request.warmup = 1;
   request.rounds = 3;
@@ -93,7 +93,7 @@ TEST(Bench, RasterReportsStagesAndNoBvh) {
   // The tile loop's passes split its wall time: in one frame they add up.
   BenchRequest one;
   one.scenePath = kCornell;
-  one.settings = stability::renderSettingsFrom({"--size", "64", "48", "--threads", "2"});
+  one.settings = renderSettingsFrom({"--size", "64", "48", "--threads", "2"});
   one.frames = 1;
   one.warmup = 0;
   const BenchResult single = runBench(one);

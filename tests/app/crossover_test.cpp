@@ -5,7 +5,7 @@
 // count; a cell that cannot run is recorded, not fatal.
 #ifdef RASTRAY_HAVE_RENDERERS
 
-#include "app/sweep_crossover.h"
+#include "app/studies/sweep_crossover.h"
 
 #include <gtest/gtest.h>
 
@@ -21,8 +21,8 @@
 #include <thread>
 #include <vector>
 
-#include "app/render_setup.h"
-#include "app/sweep_crossover_scene.h"
+#include "app/bench/terrain_scene.h"
+#include "app/engine/render_setup.h"
 #include "common/error.h"
 #include "common/interrupt.h"
 #include "common/scene.h"

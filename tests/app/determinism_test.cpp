@@ -7,15 +7,15 @@
 
 #include <tbb/global_control.h>
 
-#include "app/render_setup.h"
-#include "app/stability_measure.h"
+#include "app/engine/render_setup.h"
+#include "app/studies/stability_measure.h"
 
 namespace rastray {
 namespace {
 
 RenderRun renderWithThreads(const std::string& scene, const std::vector<std::string>& args, int threads) {
   const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-  RenderSettings settings = stability::renderSettingsFrom(args);
+  RenderSettings settings = renderSettingsFrom(args);
   settings.keepSamples = true;
   return renderScene(loadSceneForRender(scene, settings), settings);
 }

@@ -28,9 +28,9 @@
 
 #include <unistd.h>
 
-#include "app/render_setup.h"
-#include "app/stability_far_scene.h"
-#include "app/stability_measure.h"
+#include "app/engine/render_setup.h"
+#include "app/studies/stability_far_scene.h"
+#include "app/studies/stability_measure.h"
 #include "common/gltf/writer.h"
 #include "common/math_constants.h"
 #include "common/sampling.h"
@@ -209,7 +209,7 @@ struct Rendered {
 };
 
 Rendered render(const std::string& path, const std::vector<std::string>& args) {
-  const RenderSettings settings = stability::renderSettingsFrom(args);
+  const RenderSettings settings = renderSettingsFrom(args);
   Rendered r;
   r.scene = loadSceneForRender(path, settings);
   r.run = renderScene(r.scene, settings);
@@ -288,7 +288,7 @@ TEST(FarFromOriginOffsets, HybridAgreesWithTheRayCaster) {
 
 // --- the lit scene -----------------------------------------------------------
 
-// The stability study's far scene (app/stability_far_scene.h) with the
+// The stability study's far scene (app/studies/stability_far_scene.h) with the
 // box and the sphere standing on the floor and no mirror: all moved by
 // `offset`, baked into the float32 vertex data.
 GltfScene litScene(const glm::dvec3& offset) {

@@ -17,10 +17,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "app/crossval.h"
-#include "app/crossval_record.h"
-#include "app/crossval_report.h"
-#include "app/stability_measure.h"
+#include "app/crossval/crossval.h"
+#include "app/crossval/crossval_record.h"
+#include "app/crossval/crossval_report.h"
+#include "app/studies/stability_measure.h"
 #include "common/image.h"
 #include "common/interrupt.h"
 #include "tests/app/run_command.h"
@@ -108,7 +108,7 @@ TEST_F(Interrupt, WritesCompleteAndLeaveNoTemporaryFile) {
 TEST_F(Interrupt, EveryRendererThrowsFromItsTileLoop) {
   for (const char* renderer : {"raster", "raytrace", "hybrid"}) {
     const RenderSettings settings =
-        stability::renderSettingsFrom({"--renderer", renderer, "--size", "64", "48", "--spp", "2"});
+        renderSettingsFrom({"--renderer", renderer, "--size", "64", "48", "--spp", "2"});
     const Scene s = loadSceneForRender(scene("cornell-box"), settings);
     setInterruptForTesting(SIGINT);
     try {
@@ -225,7 +225,7 @@ TEST_F(Interrupt, CrossvalKeepsFinishedScenesAndResumes) {
 // read back gives the same JSON and the same index page as the original.
 TEST_F(Interrupt, CrossvalSummaryReadBackGivesTheSameIndex) {
   const RenderSettings settings =
-      stability::renderSettingsFrom({"--size", "48", "36", "--spp", "2"}, /*allRenderers=*/true);
+      renderSettingsFrom({"--size", "48", "36", "--spp", "2"}, /*allRenderers=*/true);
   std::vector<CrossvalSummary> original;
   for (const char* name : {"three-triangles", "textured-plane"})
     original.push_back(

@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/stability.h"
-#include "app/stability_report.h"
+#include "app/studies/stability.h"
+#include "app/studies/stability_report.h"
 #include "tests/app/run_command.h"
 #include "tests/test_files.h"
 

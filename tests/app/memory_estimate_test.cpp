@@ -1,9 +1,9 @@
-// The memory estimate's coverage pass (app/memory_estimate.h): projected
+// The memory estimate's coverage pass (app/engine/memory_estimate.h): projected
 // areas against hand-computed ones, clipping by the image and the near
 // plane, and the same sum at any thread count.
 #ifdef RASTRAY_HAVE_RENDERERS
 
-#include "app/memory_estimate.h"
+#include "app/engine/memory_estimate.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>

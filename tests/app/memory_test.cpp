@@ -1,6 +1,6 @@
 // --max-memory (issue 13): work whose estimated peak exceeds the budget is
 // refused with exit 2 and one line before anything large is allocated,
-// and the estimate (app/memory_estimate.h) bounds the measured peak of
+// and the estimate (app/engine/memory_estimate.h) bounds the measured peak of
 // real renders without overstating it wildly.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

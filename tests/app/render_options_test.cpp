@@ -1,5 +1,5 @@
 // Render options that do not apply to the chosen renderer are refused
-// (exit 2), not ignored: the render-option table in app/render_setup.cpp
+// (exit 2), not ignored: the render-option table in app/engine/render_setup.cpp
 // against an independent list of where each option applies, enforced by
 // RenderSettings::finish() and by the real binary.
 #ifdef RASTRAY_HAVE_RENDERERS
@@ -13,7 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "app/render_setup.h"
+#include "app/engine/render_setup.h"
 #include "common/error.h"
 #include "run_command.h"
 #include "tests/test_files.h"

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/constants.hpp>
 
-#include "app/render_setup.h"
+#include "app/engine/render_setup.h"
 #include "common/camera.h"
 #include "common/gltf/loader.h"
 #include "common/gltf/writer.h"

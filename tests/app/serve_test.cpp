@@ -1,5 +1,5 @@
 // `rastray serve`: the explorer's HTTP endpoints, with the server running in
-// this process on a free port (app/serve_server.h).
+// this process on a free port (app/serve/serve_server.h).
 #ifdef RASTRAY_HAVE_RENDERERS
 
 #include <unistd.h>
@@ -13,8 +13,8 @@
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
-#include "app/serve_api.h"
-#include "app/serve_server.h"
+#include "app/serve/serve_api.h"
+#include "app/serve/serve_server.h"
 #include "run_command.h"
 #include "tests/test_files.h"
 

@@ -1,5 +1,5 @@
 // The stability study's depth and far-from-origin cases
-// (app/stability_cases_depth.cpp, app/stability_cases_far.cpp) run in
+// (app/studies/stability_cases_depth.cpp, app/studies/stability_cases_far.cpp) run in
 // process at their --quick sizes: every row must hold its property, and
 // the failure modes the cases exist to show must still show. Plus the
 // double-precision shadow reference (checkShadows) on a scene whose shadow
@@ -14,8 +14,8 @@
 
 #include <gtest/gtest.h>
 
-#include "app/stability.h"
-#include "app/stability_measure.h"
+#include "app/studies/stability.h"
+#include "app/studies/stability_measure.h"
 
 namespace rastray::stability {
 namespace {

@@ -17,8 +17,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "app/stability.h"
-#include "app/stability_report.h"
+#include "app/studies/stability.h"
+#include "app/studies/stability_report.h"
 #include "run_command.h"
 #include "tests/test_files.h"
 

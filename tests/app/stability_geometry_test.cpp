@@ -1,4 +1,4 @@
-// The stability study's geometry cases (app/stability_cases_geometry.cpp)
+// The stability study's geometry cases (app/studies/stability_cases_geometry.cpp)
 // run in process: each case's every row must hold its property. Plus the
 // exact top-left reference the tiling case checks the rasterizer against,
 // on hand-made ties, and the generators' determinism.
@@ -10,9 +10,9 @@
 
 #include <gtest/gtest.h>
 
-#include "app/stability.h"
-#include "app/stability_coverage.h"
-#include "app/stability_geometry_scenes.h"
+#include "app/studies/stability.h"
+#include "app/studies/stability_coverage.h"
+#include "app/studies/stability_geometry_scenes.h"
 
 namespace rastray::stability {
 namespace {

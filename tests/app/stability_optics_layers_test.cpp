@@ -1,5 +1,5 @@
-// The stability study's glass and layer cases (app/stability_cases_optics.cpp,
-// app/stability_cases_layers.cpp) run in process: every row of each case must
+// The stability study's glass and layer cases (app/studies/stability_cases_optics.cpp,
+// app/studies/stability_cases_layers.cpp) run in process: every row of each case must
 // hold its property (the TIR band within a pixel of its analytic position,
 // nested glass within its energy and on-axis bounds, trapped rays ending at
 // --max-depth, stacked layers matching the analytic composite, clipped and
@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "app/stability.h"
+#include "app/studies/stability.h"
 
 namespace rastray::stability {
 namespace {

@@ -2,7 +2,7 @@
 // tests/app/xml_check.h, not by the module), labelled axes, decade ticks on
 // log axes, points inside the plot area, values a log axis cannot place
 // skipped and counted, never a NaN coordinate.
-#include "app/svg_plot.h"
+#include "app/report/svg_plot.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// `rastray sweep` (app/sweep.h): cells planned as `rastray render` parses
+// `rastray sweep` (app/studies/sweep.h): cells planned as `rastray render` parses
 // options, the CSV and JSON schemas and their exact round trip, the `auto`
 // reference (deterministic, error 0 for its own settings), depth formats on
 // a z-fighting scene, shards merging to the full table, --resume, the plots
@@ -17,9 +17,9 @@
 
 #include <gtest/gtest.h>
 
-#include "app/sweep.h"
-#include "app/sweep_report.h"
-#include "app/sweep_table.h"
+#include "app/studies/sweep.h"
+#include "app/studies/sweep_report.h"
+#include "app/studies/sweep_table.h"
 #include "common/error.h"
 #include "common/gltf/writer.h"
 #include "run_command.h"

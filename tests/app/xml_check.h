@@ -1,5 +1,5 @@
 // A strict, small XML well-formedness checker for the report tests (SVG
-// plots, HTML-embedded SVG): enough for what app/svg_plot.cpp writes.
+// plots, HTML-embedded SVG): enough for what app/report/svg_plot.cpp writes.
 #pragma once
 
 #include <map>

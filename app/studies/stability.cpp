@@ -1,0 +1,15 @@
+#include "app/studies/stability.h"
+
+namespace rastray::stability {
+
+std::vector<Case> allCases() {
+  std::vector<Case> cases;
+  appendDepthCases(cases);
+  appendFarCases(cases);
+  appendGeometryCases(cases);
+  appendOpticsCases(cases);
+  appendLayerCases(cases);
+  return cases;
+}
+
+}  // namespace rastray::stability
