@@ -42,7 +42,8 @@ struct LaneBlock {
   alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
   alignas(64) float diffuseWeight[kBlock];                              // (1 − w)(1 − t)
   alignas(64) float alpha[kBlock];                                      // BLEND: base alpha; else 1
-  // Per light, refilled for each light: position − light in double, rounded.
+  // Per light, refilled for each light: light − position (the vector to the
+  // light) in double, rounded.
   alignas(64) float toLightX[kBlock], toLightY[kBlock], toLightZ[kBlock];
   // Per light: E·cosθ where the light reaches the lane (else 0), then the
   // host's transmittance V per channel.

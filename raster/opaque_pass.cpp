@@ -29,10 +29,11 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
   TileSamples samples;
   samples.color.assign(index.count(), glm::vec4(0.0f));
   samples.front.assign(index.count(), SampleHit{});
-  // The tile's winning samples in two steps: gather the hits to shade
-  // (refined on their planes, in pixel and sample order), then shade them
-  // in one batch through the shading kernel (common/shading_kernel.h), the
-  // one the ray caster shades its primary hits with. Each sample takes the
+  // The tile's winning samples in three steps: gather the hits to shade
+  // with their primary rays (in pixel and sample order), refine them on
+  // their planes as one batch (common/primary_refinement.h), then shade
+  // them as one batch through the shading kernel (common/shading_kernel.h),
+  // the one the ray caster shades its primary hits with. Each sample takes the
   // colour of the hit it shaded or, at shading rate pixel, of the first
   // sample of its pixel on the same triangle. Per-thread scratch: no
   // allocation per tile once grown.
