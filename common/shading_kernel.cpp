@@ -42,7 +42,8 @@ struct LaneBlock {
   alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
   alignas(64) float diffuseWeight[kBlock];                              // (1 − w)(1 − t)
   alignas(64) float alpha[kBlock];                                      // BLEND: base alpha; else 1
-  // Per light, refilled for each light: position − light in double, rounded.
+  // Per light, refilled for each light: light − position (the vector to the
+  // light) in double, rounded.
   alignas(64) float toLightX[kBlock], toLightY[kBlock], toLightZ[kBlock];
   // Per light: E·cosθ where the light reaches the lane (else 0), then the
   // host's transmittance V per channel.
@@ -65,6 +66,22 @@ struct LaneLight {
   float cosOuter;             // spot: t = (cd − cosOuter) / coneDenominator
   float coneDenominator;      // max(1e-6, cos inner − cos outer)
   float dirX, dirY, dirZ;     // directional: unit, towards the light
+};
+
+// Batched refinement (primary_refinement.h): one block of lanes in double.
+constexpr size_t kRefineBlock = 64;  // a multiple of every target's double lane count (2, 4, 8)
+struct RefineBlock {
+  size_t lanes = 0;  // used lanes rounded up to whole vectors (padded with a harmless plane)
+  alignas(64) double ax[kRefineBlock], ay[kRefineBlock], az[kRefineBlock];  // canonical first corner
+  alignas(64) double e1x[kRefineBlock], e1y[kRefineBlock], e1z[kRefineBlock];
+  alignas(64) double e2x[kRefineBlock], e2y[kRefineBlock], e2z[kRefineBlock];
+  // Where stored corners 1 and 2 rank canonically: slot 0 weighs 1 − u − w, 1 u, 2 w.
+  alignas(64) double slot1[kRefineBlock], slot2[kRefineBlock];
+  alignas(64) double ox[kRefineBlock], oy[kRefineBlock], oz[kRefineBlock];
+  alignas(64) double dx[kRefineBlock], dy[kRefineBlock], dz[kRefineBlock];
+  alignas(64) double depthPerT[kRefineBlock];
+  // Out: the clamped barycentrics, and 1 where they replace the hit's.
+  alignas(64) double b1[kRefineBlock], b2[kRefineBlock], refined[kRefineBlock];
 };
 
 }  // namespace kernel_detail
@@ -227,6 +244,56 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   }
 }
 
+size_t RefineLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
+
+// intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp}),
+// operation for operation: glm's cross (x.y·y.z − y.y·x.z, ...) and dot
+// ((x + y) + z), the canonical slots mapped back, the plane kept only ahead
+// of the ray, the clamp max(b, 0) as glm's (b < 0 ? 0 : b), then the scale
+// onto the edge v1–v2.
+void LanesRefine(kernel_detail::RefineBlock* b) {
+  const hn::ScalableTag<double> d;
+  const size_t N = hn::Lanes(d);
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const auto dx = hn::Load(d, b->dx + i), dy = hn::Load(d, b->dy + i), dz = hn::Load(d, b->dz + i);
+    const auto e1x = hn::Load(d, b->e1x + i), e1y = hn::Load(d, b->e1y + i), e1z = hn::Load(d, b->e1z + i);
+    const auto e2x = hn::Load(d, b->e2x + i), e2y = hn::Load(d, b->e2y + i), e2z = hn::Load(d, b->e2z + i);
+    // p = direction × e2
+    const auto px = hn::Sub(hn::Mul(dy, e2z), hn::Mul(e2y, dz));
+    const auto py = hn::Sub(hn::Mul(dz, e2x), hn::Mul(e2z, dx));
+    const auto pz = hn::Sub(hn::Mul(dx, e2y), hn::Mul(e2x, dy));
+    const auto det = hn::Add(hn::Add(hn::Mul(e1x, px), hn::Mul(e1y, py)), hn::Mul(e1z, pz));
+    auto ok = hn::Gt(hn::Abs(det), zero);
+    const auto inv = hn::Div(one, det);
+    // s = origin − a, q = s × e1
+    const auto sx = hn::Sub(hn::Load(d, b->ox + i), hn::Load(d, b->ax + i));
+    const auto sy = hn::Sub(hn::Load(d, b->oy + i), hn::Load(d, b->ay + i));
+    const auto sz = hn::Sub(hn::Load(d, b->oz + i), hn::Load(d, b->az + i));
+    const auto u = hn::Mul(hn::Add(hn::Add(hn::Mul(sx, px), hn::Mul(sy, py)), hn::Mul(sz, pz)), inv);
+    const auto qx = hn::Sub(hn::Mul(sy, e1z), hn::Mul(e1y, sz));
+    const auto qy = hn::Sub(hn::Mul(sz, e1x), hn::Mul(e1z, sx));
+    const auto qz = hn::Sub(hn::Mul(sx, e1y), hn::Mul(e1x, sy));
+    const auto w = hn::Mul(hn::Add(hn::Add(hn::Mul(dx, qx), hn::Mul(dy, qy)), hn::Mul(dz, qz)), inv);
+    const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(e2x, qx), hn::Mul(e2y, qy)), hn::Mul(e2z, qz)), inv);
+    ok = hn::And(ok, hn::And(hn::IsFinite(t), hn::And(hn::IsFinite(u), hn::IsFinite(w))));
+    const auto w0 = hn::Sub(hn::Sub(one, u), w);
+    const auto s1 = hn::Load(d, b->slot1 + i), s2 = hn::Load(d, b->slot2 + i);
+    auto b1 = hn::IfThenElse(hn::Eq(s1, zero), w0, hn::IfThenElse(hn::Eq(s1, one), u, w));
+    auto b2 = hn::IfThenElse(hn::Eq(s2, zero), w0, hn::IfThenElse(hn::Eq(s2, one), u, w));
+    ok = hn::And(ok, hn::And(hn::Gt(t, zero), hn::IsFinite(hn::Mul(t, hn::Load(d, b->depthPerT + i)))));
+    b1 = hn::IfThenElse(hn::Lt(b1, zero), zero, b1);
+    b2 = hn::IfThenElse(hn::Lt(b2, zero), zero, b2);
+    const auto sum = hn::Add(b1, b2);
+    const auto over = hn::Gt(sum, one);
+    b1 = hn::IfThenElse(over, hn::Div(b1, sum), b1);
+    b2 = hn::IfThenElse(over, hn::Div(b2, sum), b2);
+    hn::Store(b1, d, b->b1 + i);
+    hn::Store(b2, d, b->b2 + i);
+    hn::Store(hn::IfThenElseZero(ok, one), d, b->refined + i);
+  }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace rastray
 HWY_AFTER_NAMESPACE();
@@ -238,8 +305,10 @@ HWY_AFTER_NAMESPACE();
 #include <optional>
 
 #include "common/optics.h"
+#include "common/primary_refinement.h"
 #include "common/shading.h"
 #include "common/surface.h"
+#include "common/triangle_plane.h"
 
 namespace rastray {
 
@@ -248,6 +317,8 @@ HWY_EXPORT(LanesNormals);
 HWY_EXPORT(LanesLightWeight);
 HWY_EXPORT(LanesAccumulate);
 HWY_EXPORT(LanesFinish);
+HWY_EXPORT(RefineLanes);
+HWY_EXPORT(LanesRefine);
 
 using kernel_detail::kBlock;
 using kernel_detail::LaneBlock;
@@ -390,8 +461,7 @@ class BlockShader {
     const float w = m.mirrorWeight();
     b.diffuseWeight[i] = (1.0f - w) * (1.0f - m.transmission);
     b.alpha[i] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
-    if (!shader_.eyeLight())
-      positions_[i] = b0 * run_.p0 + double(h.b1) * run_.p1 + double(h.b2) * run_.p2;
+    if (!shader_.eyeLight()) positions_[i] = b0 * run_.p0 + double(h.b1) * run_.p1 + double(h.b2) * run_.p2;
   }
 
   // Shades the gathered lanes and writes their colours; empties the block.
@@ -534,6 +604,61 @@ void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, 
     if (block->full()) block->run();
   }
   if (block) block->run();
+}
+
+void refinePrimaryHits(const Scene& scene, const Ray* rays, const SampleHit* hits,
+                       const glm::dvec2* footprintPositions, size_t count, ShadeHit* out) {
+  using kernel_detail::kRefineBlock;
+  using kernel_detail::RefineBlock;
+  RefineBlock b;
+  const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(RefineLanes)();
+  uint32_t runInstance = kNoId, runTriangle = kNoId;
+  TrianglePlane plane{};
+  for (size_t first = 0; first < count; first += kRefineBlock) {
+    const size_t used = std::min(kRefineBlock, count - first);
+    for (size_t k = 0; k < used; ++k) {
+      const SampleHit& hit = hits[first + k];
+      const Ray& ray = rays[first + k];
+      // A triangle's plane once per run of hits on it (the memo's values).
+      if (hit.instance != runInstance || hit.triangle != runTriangle) {
+        plane = trianglePlane(scene, hit.instance, hit.triangle);
+        runInstance = hit.instance;
+        runTriangle = hit.triangle;
+      }
+      b.ax[k] = plane.a.x, b.ay[k] = plane.a.y, b.az[k] = plane.a.z;
+      b.e1x[k] = plane.e1.x, b.e1y[k] = plane.e1.y, b.e1z[k] = plane.e1.z;
+      b.e2x[k] = plane.e2.x, b.e2y[k] = plane.e2.y, b.e2z[k] = plane.e2.z;
+      b.slot1[k] = double(plane.slot1);
+      b.slot2[k] = double(plane.slot2);
+      b.ox[k] = ray.origin.x, b.oy[k] = ray.origin.y, b.oz[k] = ray.origin.z;
+      b.dx[k] = ray.direction.x, b.dy[k] = ray.direction.y, b.dz[k] = ray.direction.z;
+      b.depthPerT[k] = ray.depthPerT;
+    }
+    // Padding: a unit plane z = 0 seen from +z, never read back.
+    b.lanes = (used + vectorLanes - 1) / vectorLanes * vectorLanes;
+    for (size_t k = used; k < b.lanes; ++k) {
+      b.ax[k] = b.ay[k] = b.az[k] = 0.0;
+      b.e1x[k] = 1.0, b.e1y[k] = b.e1z[k] = 0.0;
+      b.e2y[k] = 1.0, b.e2x[k] = b.e2z[k] = 0.0;
+      b.slot1[k] = 1.0, b.slot2[k] = 2.0;
+      b.ox[k] = b.oy[k] = 0.0, b.oz[k] = 1.0;
+      b.dx[k] = b.dy[k] = 0.0, b.dz[k] = -1.0;
+      b.depthPerT[k] = 1.0;
+    }
+    HWY_DYNAMIC_DISPATCH(LanesRefine)(&b);
+    for (size_t k = 0; k < used; ++k) {
+      const SampleHit& hit = hits[first + k];
+      ShadeHit& s = out[first + k];
+      s.instance = hit.instance;
+      s.triangle = hit.triangle;
+      const bool refined = b.refined[k] != 0.0;
+      s.b1 = refined ? float(b.b1[k]) : hit.b1;
+      s.b2 = refined ? float(b.b2[k]) : hit.b2;
+      s.direction = rays[first + k].direction;
+      s.footprintPosition = footprintPositions[first + k];
+      s.throughput = 1.0f;
+    }
+  }
 }
 
 const char* shadingKernelTarget() {

@@ -1,5 +1,7 @@
 #include "common/surface.h"
 
+#include "common/triangle_plane.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -147,10 +149,10 @@ SurfacePoint surfacePointOnRay(const Scene& scene, const Ray& ray, const SampleH
   return surfacePointAt(scene, hit.instance, hit.triangle, float(clamped.x), float(clamped.y));
 }
 
-bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle, const Ray& ray,
-                            double* t, glm::dvec2* barycentrics) {
-  const glm::uvec3 v = scene.triangle(instance, triangle);
-  const glm::vec3 &f0 = scene.positions[v.x], &f1 = scene.positions[v.y], &f2 = scene.positions[v.z];
+namespace {
+
+// The plane memo brought up to date for corners f0, f1, f2.
+PlaneMemo& planeMemoFor(const glm::vec3& f0, const glm::vec3& f1, const glm::vec3& f2) {
   PlaneMemo& memo = planeMemo;
   if (!memo.valid || !sameCorners(memo.key, f0, f1, f2)) {
     // The corners in a canonical (lexicographic) order, so that coincident
@@ -182,6 +184,21 @@ bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t tria
     memo.valid = true;
     memo.originValid = false;
   }
+  return memo;
+}
+
+}  // namespace
+
+TrianglePlane trianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle) {
+  const glm::uvec3 v = scene.triangle(instance, triangle);
+  const PlaneMemo& memo = planeMemoFor(scene.positions[v.x], scene.positions[v.y], scene.positions[v.z]);
+  return {memo.a, memo.e1, memo.e2, memo.slot1, memo.slot2};
+}
+
+bool intersectTrianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle, const Ray& ray,
+                            double* t, glm::dvec2* barycentrics) {
+  const glm::uvec3 v = scene.triangle(instance, triangle);
+  PlaneMemo& memo = planeMemoFor(scene.positions[v.x], scene.positions[v.y], scene.positions[v.z]);
   const glm::dvec3 e1 = memo.e1, e2 = memo.e2;
   // Compared bit for bit: −0 and +0 may give differently signed zeros in s.
   if (!memo.originValid || std::memcmp(&memo.origin, &ray.origin, sizeof memo.origin) != 0) {

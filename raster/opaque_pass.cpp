@@ -7,6 +7,7 @@
 #include <functional>
 #include <utility>
 
+#include "common/primary_refinement.h"
 #include "common/shading_kernel.h"
 #include "raster/tile_renderer.h"
 
@@ -28,10 +29,11 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
   TileSamples samples;
   samples.color.assign(index.count(), glm::vec4(0.0f));
   samples.front.assign(index.count(), SampleHit{});
-  // The tile's winning samples in two steps: gather the hits to shade
-  // (refined on their planes, in pixel and sample order), then shade them
-  // in one batch through the shading kernel (common/shading_kernel.h), the
-  // one the ray caster shades its primary hits with. Each sample takes the
+  // The tile's winning samples in three steps: gather the hits to shade
+  // with their primary rays (in pixel and sample order), refine them on
+  // their planes as one batch (common/primary_refinement.h), then shade
+  // them as one batch through the shading kernel (common/shading_kernel.h),
+  // the one the ray caster shades its primary hits with. Each sample takes the
   // colour of the hit it shaded or, at shading rate pixel, of the first
   // sample of its pixel on the same triangle. Per-thread scratch: no
   // allocation per tile once grown.
@@ -39,10 +41,15 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
     uint32_t local;    // TileSampleIndex
     uint32_t request;  // index into `requests`
   };
-  thread_local std::vector<ShadeHit> requests;
+  thread_local std::vector<SampleHit> hits;         // interpolated, per request
+  thread_local std::vector<Ray> rays;               // primary ray through the sample, per request
+  thread_local std::vector<glm::dvec2> footprints;  // image position of the texture footprint
+  thread_local std::vector<ShadeHit> requests;      // refined (refinePrimaryHits)
   thread_local std::vector<glm::vec4> colors;
   thread_local std::vector<Assignment> assignments;
-  requests.clear();
+  hits.clear();
+  rays.clear();
+  footprints.clear();
   assignments.clear();
   std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, request)
   for (int py = rect.y0; py < rect.y1; ++py)
@@ -69,19 +76,26 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
             // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
             const SampleHit hit = interpolatedHit(t, pos);
             samples.front[local] = hit;
-            request = uint32_t(requests.size());
-            requests.push_back(refinePrimaryHit(scene_, rays_(pos), hit, corner + glm::dvec2(0.5)));
+            request = uint32_t(hits.size());
+            hits.push_back(hit);
+            rays.push_back(rays_(pos));
+            footprints.push_back(corner + glm::dvec2(0.5));
             pixelCache.emplace_back(t.id(), request);
           }
         } else {
           const SampleHit hit = interpolatedHit(t, pos);
           samples.front[local] = hit;
-          request = uint32_t(requests.size());
-          requests.push_back(refinePrimaryHit(scene_, rays_(pos), hit, pos));
+          request = uint32_t(hits.size());
+          hits.push_back(hit);
+          rays.push_back(rays_(pos));
+          footprints.push_back(pos);
         }
         assignments.push_back({local, request});
       }
     }
+  // Refined on their planes in double lanes (refinePrimaryHit's bits).
+  requests.resize(hits.size());
+  refinePrimaryHits(scene_, rays.data(), hits.data(), footprints.data(), hits.size(), requests.data());
   colors.resize(requests.size());
   shadePrimaryHits(shader_, requests.data(), requests.size(), colors.data(), shadingPath());
   n.shadedSamples += requests.size();

@@ -19,7 +19,9 @@
 //   plane depth          view depth where the primary ray meets the stored
 //                        triangle's plane, in double (planeDepth): what
 //                        orders BLEND layers, as the ray caster orders them.
-// Shading refines the hit on that plane again (refineHit, common/surface.h).
+// Shading refines the hit on that plane again (refinePrimaryHits, a tile at a
+// time: common/primary_refinement.h) and shades a tile's hits as one batch
+// (common/shading_kernel.h), as the ray caster does.
 #pragma once
 
 #include <cstdint>

@@ -6,7 +6,7 @@
 // samples are box-filtered into the flat image. A ray that gathered no
 // BLEND layer (every ray of an opaque scene) is shaded straight from its
 // stopping hit when neither deep output nor a ray tree is wanted
-// (prepareStoppingHit: the surface list's result, bit for bit, without
+// (stoppingSurface: the surface list's result, bit for bit, without
 // the list; ≈ 4 % of the frame on the CAD model), those of a tile in one
 // batch through the shading kernel (common/shading_kernel.h). The deep output keeps
 // every sample's surfaces, per tile in one buffer, and is assembled into
@@ -29,6 +29,7 @@
 
 #include "common/interrupt.h"
 #include "common/parallel.h"
+#include "common/primary_refinement.h"
 #include "common/sampling.h"
 #include "raytrace/ray_caster_parts.h"
 
@@ -69,8 +70,11 @@ struct TileScratch {
   // Phase 2: each sample's result, and the stopping hits shaded as one
   // batch by the shading kernel (the samples they belong to, their colours).
   std::vector<SampleResult> results;
-  std::vector<ShadeHit> stoppingHits;
-  std::vector<uint32_t> stoppingSamples;
+  std::vector<uint32_t> stoppingSamples;  // the samples resolved from their stopping hit
+  std::vector<Ray> stoppingRays;          // their primary rays, hits (Embree's) and footprint positions
+  std::vector<SampleHit> stoppingHits;
+  std::vector<glm::dvec2> stoppingFootprints;
+  std::vector<ShadeHit> stoppingRefined;  // refined (refinePrimaryHits), then shaded
   std::vector<glm::vec4> stoppingColors;
   // The packets' trace order (traceOrder) for tiles of orderSize × orderSpp.
   std::vector<uint32_t> order;
@@ -119,8 +123,8 @@ SampleResult resolvePrimary(const CasterState& state, const RayTreeContext& cont
                             const GatheredHit& closest, uint32_t sampleIndex, std::vector<DeepSample>* deep,
                             std::vector<SurfaceCrossing>* crossings);
 bool stoppingHitOnly(const HitGather& g, const std::vector<DeepSample>* deep, const RayTreeContext& context);
-bool prepareStoppingHit(const CasterState& state, const RayTreeContext& context, const HitGather& g,
-                        const GatheredHit& closest, SampleResult* r, ShadeHit* shade);
+bool stoppingSurface(const HitGather& g, const GatheredHit& closest, SampleResult* r, SampleHit* hit);
+bool shadesStoppingSurface(const CasterState& state, const RayTreeContext& context, const SampleHit& hit);
 
 }  // namespace
 
@@ -211,16 +215,20 @@ void renderTile(const CasterState& state, const Tile& tile, const std::vector<gl
   // in sample order.
   FlatImage& img = *image;
   std::vector<SampleResult>& results = scratch.results;
-  scratch.stoppingHits.clear();
   scratch.stoppingSamples.clear();
+  scratch.stoppingRays.clear();
+  scratch.stoppingHits.clear();
+  scratch.stoppingFootprints.clear();
   for (size_t i = 0; i < n; ++i) {
     const TileSample& s = samples[i];
     HitGather& g = scratch.gathers[i];
     if (stoppingHitOnly(g, tileDeep, context)) {
-      ShadeHit shade;
-      if (prepareStoppingHit(state, context, g, scratch.closest[i], &results[i], &shade)) {
-        scratch.stoppingHits.push_back(shade);
+      SampleHit hit;
+      if (stoppingSurface(g, scratch.closest[i], &results[i], &hit)) {
         scratch.stoppingSamples.push_back(uint32_t(i));
+        scratch.stoppingRays.push_back(g.ray);
+        scratch.stoppingHits.push_back(hit);
+        scratch.stoppingFootprints.push_back(g.imagePosition);
       }
       continue;
     }
@@ -230,14 +238,32 @@ void renderTile(const CasterState& state, const Tile& tile, const std::vector<gl
                                 &scratch.crossings);
     if (tileDeep) (*pixelCounts)[pixel] += uint32_t(tileDeep->size() - before);
   }
-  scratch.stoppingColors.resize(scratch.stoppingHits.size());
-  shadePrimaryHits(*context.shader, scratch.stoppingHits.data(), scratch.stoppingHits.size(),
-                   scratch.stoppingColors.data(), shadingPath(state));
-  for (size_t k = 0; k < scratch.stoppingSamples.size(); ++k) {
-    // composite's first `over` of a surface with nothing in front of it:
-    // 0 + remaining·c, remaining = 1 (−0 becomes +0).
-    const float remaining = 1.0f - 0.0f;
-    results[scratch.stoppingSamples[k]].color = glm::vec4(0.0f) + remaining * scratch.stoppingColors[k];
+  // The stopping hits refined in double lanes (refinePrimaryHit's bits):
+  // the front surface reports the refined barycentrics, as the list's
+  // entry has them. Then shaded as one batch, unless the cutoff stops
+  // every sample (nothing is in front of a stopping hit: the same test for
+  // all).
+  const size_t stopping = scratch.stoppingSamples.size();
+  scratch.stoppingRefined.resize(stopping);
+  refinePrimaryHits(state.scene, scratch.stoppingRays.data(), scratch.stoppingHits.data(),
+                    scratch.stoppingFootprints.data(), stopping, scratch.stoppingRefined.data());
+  bool shade = false;
+  for (size_t k = 0; k < stopping; ++k) {
+    SampleResult& r = results[scratch.stoppingSamples[k]];
+    r.front.b1 = scratch.stoppingRefined[k].b1;
+    r.front.b2 = scratch.stoppingRefined[k].b2;
+    shade = shadesStoppingSurface(state, context, scratch.stoppingHits[k]);
+  }
+  if (shade) {
+    scratch.stoppingColors.resize(stopping);
+    shadePrimaryHits(*context.shader, scratch.stoppingRefined.data(), stopping, scratch.stoppingColors.data(),
+                     shadingPath(state));
+    for (size_t k = 0; k < stopping; ++k) {
+      // composite's first `over` of a surface with nothing in front of it:
+      // 0 + remaining·c, remaining = 1 (−0 becomes +0).
+      const float remaining = 1.0f - 0.0f;
+      results[scratch.stoppingSamples[k]].color = glm::vec4(0.0f) + remaining * scratch.stoppingColors[k];
+    }
   }
   for (size_t i = 0; i < n; ++i) {
     const TileSample& s = samples[i];
@@ -439,7 +465,7 @@ void setupPrimary(const CasterState& state, HitGather& g, glm::ivec2 pixel, cons
 // Whether a traced primary ray's surface list is its stopping hit alone
 // (it gathered no layer: every ray of an opaque scene) and neither deep
 // samples nor a ray tree are wanted: then it is resolved from that hit
-// (prepareStoppingHit), without building the list.
+// (stoppingSurface), without building the list.
 bool stoppingHitOnly(const HitGather& g, const std::vector<DeepSample>* deep, const RayTreeContext& context) {
   return g.hits.empty() && !deep && !context.recorder;
 }
@@ -449,32 +475,33 @@ bool stoppingHitOnly(const HitGather& g, const std::vector<DeepSample>* deep, co
 // was written field by field and read back in wider pieces: a
 // store-forwarding stall per ray). The same operations in the same order,
 // so the same bits: the hit refined as appendSurfaceCrossing refines it
-// (refinePrimaryHit, surfacePointOnRay's steps), depth Embree's t ×
-// depthPerT. Sets r's front surface; returns whether the hit is to be
-// shaded (`shade`: its colour c then makes r.color = 0 + 1·c, as
-// composite's first `over`); false for a miss or when the cutoff stops it.
-bool prepareStoppingHit(const CasterState& state, const RayTreeContext& context, const HitGather& g,
-                        const GatheredHit& closest, SampleResult* r, ShadeHit* shade) {
+// (refinePrimaryHit, or refinePrimaryHits for a tile: surfacePointOnRay's
+// steps), depth Embree's t × depthPerT, the colour c of the refined hit
+// making r.color = 0 + 1·c, as composite's first `over`.
+//
+// stoppingSurface: r's front surface (its barycentrics still Embree's, to
+// be replaced by the refined ones) and the hit to refine; false for a
+// miss (no surface, colour 0).
+bool stoppingSurface(const HitGather& g, const GatheredHit& closest, SampleResult* r, SampleHit* hit) {
   *r = SampleResult{};
-  if (closest.instance == kNoId) return false;  // a miss: no surface, colour 0
+  if (closest.instance == kNoId) return false;
   r->front.instance = closest.instance;
   r->front.triangle = closest.triangle;
   r->front.depth = float(double(closest.traversalT) * g.ray.depthPerT);
-  SampleHit hit;
-  hit.instance = closest.instance;
-  hit.triangle = closest.triangle;
-  hit.b1 = closest.u;
-  hit.b2 = closest.v;
-  hit.depth = r->front.depth;
-  *shade = refinePrimaryHit(state.scene, g.ray, hit, g.imagePosition);
-  r->front.b1 = shade->b1;  // the refined barycentrics, as the list's entry has them
-  r->front.b2 = shade->b2;
+  *hit = SampleHit{closest.instance, closest.triangle, r->front.depth, closest.u, closest.v};
+  r->front.b1 = hit->b1;
+  r->front.b2 = hit->b2;
+  return true;
+}
+
+// Whether the stopping surface is shaded: not when the transparency
+// cutoff stops even the first surface. Counts a BLEND surface that stopped
+// the ray (no filter gathered it): the ray would continue behind it, but
+// nothing was found there.
+bool shadesStoppingSurface(const CasterState& state, const RayTreeContext& context, const SampleHit& hit) {
   const float remaining = 1.0f - 0.0f;  // nothing in front of it
   if (remaining < state.options.transparencyCutoff) return false;
-  shade->throughput = 1.0f * remaining;
-  // A BLEND surface that stopped the ray (no filter gathered it): the ray
-  // would continue behind it, but nothing was found there.
-  if (state.scene.materialOf(closest.instance).alphaMode == AlphaMode::Blend)
+  if (state.scene.materialOf(hit.instance).alphaMode == AlphaMode::Blend)
     context.count(RayKind::Transparency);
   return true;
 }
@@ -486,10 +513,14 @@ SampleResult resolvePrimary(const CasterState& state, const RayTreeContext& cont
                             std::vector<SurfaceCrossing>* crossings) {
   if (stoppingHitOnly(g, deep, context)) {
     SampleResult r;
-    ShadeHit shade;
-    if (prepareStoppingHit(state, context, g, closest, &r, &shade)) {
+    SampleHit hit;
+    if (!stoppingSurface(g, closest, &r, &hit)) return r;
+    const ShadeHit refined = refinePrimaryHit(state.scene, g.ray, hit, g.imagePosition);
+    r.front.b1 = refined.b1;
+    r.front.b2 = refined.b2;
+    if (shadesStoppingSurface(state, context, hit)) {
       glm::vec4 c;
-      shadePrimaryHits(*context.shader, &shade, 1, &c, shadingPath(state));
+      shadePrimaryHits(*context.shader, &refined, 1, &c, shadingPath(state));
       r.color = glm::vec4(0.0f) + 1.0f * c;
     }
     return r;

@@ -1,0 +1,24 @@
+// Internal to common/: the canonical plane data of a stored triangle that
+// intersectTrianglePlane (common/surface.h) intersects rays with, for the
+// shading kernel's batched refinement (common/primary_refinement.h), which
+// must give intersectTrianglePlane's bits.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "common/scene.h"
+
+namespace rastray {
+
+struct TrianglePlane {
+  glm::dvec3 a, e1, e2;  // first canonical (lexicographic) corner, edges to the other two
+  int slot1, slot2;      // canonical rank of stored corners 1 and 2
+};
+
+// The values intersectTrianglePlane uses for (instance, triangle), bit for
+// bit (the same per-thread memo).
+TrianglePlane trianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle);
+
+}  // namespace rastray
