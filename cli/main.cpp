@@ -4,7 +4,8 @@
 // threshold; 2 bad usage or bad input, with one line on stderr naming the
 // file and the offending element; 128 + the signal's number (130, 143)
 // when Ctrl-C or SIGTERM stopped a render, crossval, sweep, bench or
-// stability run (common/interrupt.h), after a line saying what it finished.
+// stability run (common/interrupt.h, cli/exit_status.h), after a line
+// saying what it finished.
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -13,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
+#include "cli/exit_status.h"
 #include "common/error.h"
 #include "common/interrupt.h"
 

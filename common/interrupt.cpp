@@ -46,8 +46,6 @@ const char* signalName(int signal) {
 
 }  // namespace
 
-int interruptedExitStatus(int signal) { return 128 + signal; }
-
 Interrupted::Interrupted(int signal, std::string finished)
     : std::runtime_error("interrupted"), signal_(signal), finished_(std::move(finished)) {}
 

@@ -4,7 +4,7 @@
 // cell loops poll the record and stop at their next check, so every output
 // already written stays whole and no temporary file is left (SPEC §7: no
 // partial output). The command then says on stderr what it finished, and
-// main() exits with interruptedExitStatus().
+// main() exits with interruptedExitStatus() (cli/exit_status.h).
 //
 // Where the checks are (how soon a request is honoured):
 // - the rasterizer's and the ray caster's tile loops (raster/rasterizer.cpp,
@@ -26,14 +26,6 @@
 #include <string>
 
 namespace rastray {
-
-// The exit status of a command stopped by a signal: 128 + the signal's
-// number, 130 for SIGINT and 143 for SIGTERM, the status a shell reports
-// for a process the signal killed, so scripts that test for it (`$? -ge
-// 128`, `-eq 130`) treat a stopped rastray like any stopped program. It
-// cannot collide with SPEC §7's 0, 1 and 2. This is the one place the
-// choice is made.
-int interruptedExitStatus(int signal);
 
 // Thrown by throwIfInterrupted() once a stop was requested. `finished`
 // says what the command completed ("nothing written" unless a command

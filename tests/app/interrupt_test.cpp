@@ -21,6 +21,7 @@
 #include "app/crossval/crossval_record.h"
 #include "app/crossval/crossval_report.h"
 #include "app/studies/stability_measure.h"
+#include "cli/exit_status.h"
 #include "common/image.h"
 #include "common/interrupt.h"
 #include "tests/app/run_command.h"
