@@ -81,11 +81,30 @@ int64_t snapUnits(double c, double U) {
   return int64_t(std::clamp(s, -double(kMaxCoordinateUnits), double(kMaxCoordinateUnits)));
 }
 
+// Whether the closed box [minX, maxX] × [minY, maxY] (units) holds a
+// sample of the pixels [pmin, pmax]. A sample that passes the three edge
+// tests lies in the closed triangle (E >= −bias >= 0), so in its box:
+// without one, the triangle covers no sample.
+bool boxHoldsSample(int64_t minX, int64_t maxX, int64_t minY, int64_t maxY, const glm::ivec2& pmin,
+                    const glm::ivec2& pmax, const SampleGrid& grid) {
+  const int64_t U = grid.unitsPerPixel;
+  for (const glm::i64vec2& o : grid.offsets) {
+    // Pixels p with min <= p·U + o <= max: from ceil((min − o)/U) to floor((max − o)/U).
+    const int64_t x0 = std::max<int64_t>(pmin.x, -floorDiv(o.x - minX, U));
+    const int64_t x1 = std::min<int64_t>(pmax.x, floorDiv(maxX - o.x, U));
+    const int64_t y0 = std::max<int64_t>(pmin.y, -floorDiv(o.y - minY, U));
+    const int64_t y1 = std::min<int64_t>(pmax.y, floorDiv(maxY - o.y, U));
+    if (x0 <= x1 && y0 <= y1) return true;
+  }
+  return false;
+}
+
 // The integer half of setup, from the snapped vertices: area, facing,
 // culling, pixel bounds, the vertex order of positive area (`order`) and
-// the edge functions (their `original` flags are left false).
+// the edge functions (their `original` flags are left false). With
+// `dropSampleless`, NoSample where mayCoverSample would be false.
 SetupOutcome setupEdges(const ClipSpace& space, const SampleGrid& grid, const glm::i64vec2 snapped[3],
-                        CullMode cull, int order[3], TriangleSetup* t) {
+                        CullMode cull, bool dropSampleless, int order[3], TriangleSetup* t) {
   const int64_t area2 = (snapped[1].x - snapped[0].x) * (snapped[2].y - snapped[0].y) -
                         (snapped[1].y - snapped[0].y) * (snapped[2].x - snapped[0].x);
   if (area2 == 0) return SetupOutcome::Degenerate;  // zero area after snapping: covers nothing
@@ -104,6 +123,13 @@ SetupOutcome setupEdges(const ClipSpace& space, const SampleGrid& grid, const gl
   t->pixelMax = {int(std::clamp<int64_t>(floorDiv(maxX, grid.unitsPerPixel), -1, space.width - 1)),
                  int(std::clamp<int64_t>(floorDiv(maxY, grid.unitsPerPixel), -1, space.height - 1))};
   if (t->pixelMin.x > t->pixelMax.x || t->pixelMin.y > t->pixelMax.y) return SetupOutcome::Offscreen;
+  // Most sub-pixel triangles hold no sample in their box: known before
+  // their edge functions are made.
+  const bool searched =
+      int64_t(t->pixelMax.x - t->pixelMin.x + 1) * (t->pixelMax.y - t->pixelMin.y + 1) * grid.spp <=
+      kSampleSearchLimit;
+  if (dropSampleless && searched && !boxHoldsSample(minX, maxX, minY, maxY, t->pixelMin, t->pixelMax, grid))
+    return SetupOutcome::NoSample;
 
   // Reorder to positive area: swap vertices 1 and 2 of front faces.
   order[0] = 0;
@@ -123,6 +149,7 @@ SetupOutcome setupEdges(const ClipSpace& space, const SampleGrid& grid, const gl
     e.bias = e.topLeft ? 0 : -1;
     e.original = false;
   }
+  if (dropSampleless && searched && !mayCoverSample(*t, grid)) return SetupOutcome::NoSample;
   return SetupOutcome::Ok;
 }
 
@@ -192,7 +219,7 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
     snapped[i] = {snapUnits(image[i].x, U), snapUnits(image[i].y, U)};
   }
   int order[3];
-  const SetupOutcome o = setupEdges(space, grid, snapped, cull, order, t);
+  const SetupOutcome o = setupEdges(space, grid, snapped, cull, false, order, t);
   if (o != SetupOutcome::Ok) return o;
   setupPlanes(grid, ds, v, image, order, t);
   return SetupOutcome::Ok;
@@ -397,7 +424,8 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
                                      {codes.snapped[idx.y].x, codes.snapped[idx.y].y},
                                      {codes.snapped[idx.z].x, codes.snapped[idx.z].y}};
     int order[3];
-    const SetupOutcome o = setupEdges(c.space, c.grid, snapped, instanceCull, order, &t);
+    const SetupOutcome o =
+        setupEdges(c.space, c.grid, snapped, instanceCull, !c.filter.keepSampleless, order, &t);
     if (o == SetupOutcome::Degenerate) {
       ++n.degenerate;  // zero area after snapping: sub-pixel sliver or edge-on
       continue;
@@ -410,7 +438,7 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
       ++n.outside;
       continue;
     }
-    if (!c.filter.keepSampleless && !mayCoverSample(t, c.grid)) {
+    if (o == SetupOutcome::NoSample) {
       ++n.noSample;
       continue;
     }

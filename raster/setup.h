@@ -126,7 +126,9 @@ struct DepthSettings {
   double offsetFactor = 0.0, offsetUnits = 0.0;
 };
 
-enum class SetupOutcome { Ok, Degenerate, Culled, Offscreen };  // Offscreen: no pixel of the image
+// Offscreen: no pixel of the image. NoSample: covers no sample
+// (mayCoverSample false); only prepareTriangles' own steps tell it apart.
+enum class SetupOutcome { Ok, Degenerate, Culled, Offscreen, NoSample };
 
 // Pixel bounds of at most this many samples are searched for a covered
 // sample; larger ones are assumed to cover one (mayCoverSample).
