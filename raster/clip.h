@@ -73,9 +73,10 @@ struct ClipResult {
 };
 
 // Bit p set when clip position v lies outside plane p (bit 0 near, 1 far,
-// 2–5 the guard band's +x, −x, +y, −y sides): a pure function of the vertex, so a vertex shared by many
-// triangles is classified once. A triangle is trivially outside when its three masks share a bit, and needs
-// no clipping when their union is 0.
+// 2–5 the guard band's +x, −x, +y, −y sides). A pure function of the
+// vertex, so a vertex shared by many triangles is classified once: a
+// triangle is trivially outside when its three masks share a bit, and
+// needs no clipping when their union is 0 (what clipTriangle decides).
 uint8_t outsidePlanes(const ClipSpace& space, const glm::dvec4& v);
 
 // Clips the triangle with clip-space positions v[0..2] (bary = unit

@@ -64,7 +64,14 @@ Plane makePlane(const double x[3], const double y[3], const double a[3], double 
   return {c.v0, c.dx, c.dy, x[0], y[0]};
 }
 
-int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+int64_t floorDiv(int64_t a, int64_t b) {
+  // 256·k units per pixel, a power of two for every pattern but the odd
+  // grids: then floor division is an arithmetic shift (C++17 leaves >> of
+  // negatives implementation-defined; GCC and Clang shift arithmetically),
+  // which spares the four 64-bit divisions per triangle.
+  if ((b & (b - 1)) == 0) return a >> __builtin_ctzll(uint64_t(b));
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
 
 // An image coordinate (pixels) on the fixed-point grid. Clamping only moves
 // vertices that the guard-band clip left a rounding error beyond it; inside
@@ -74,11 +81,30 @@ int64_t snapUnits(double c, double U) {
   return int64_t(std::clamp(s, -double(kMaxCoordinateUnits), double(kMaxCoordinateUnits)));
 }
 
+// Whether the closed box [minX, maxX] × [minY, maxY] (units) holds a
+// sample of the pixels [pmin, pmax]. A sample that passes the three edge
+// tests lies in the closed triangle (E >= −bias >= 0), so in its box:
+// without one, the triangle covers no sample.
+bool boxHoldsSample(int64_t minX, int64_t maxX, int64_t minY, int64_t maxY, const glm::ivec2& pmin,
+                    const glm::ivec2& pmax, const SampleGrid& grid) {
+  const int64_t U = grid.unitsPerPixel;
+  for (const glm::i64vec2& o : grid.offsets) {
+    // Pixels p with min <= p·U + o <= max: from ceil((min − o)/U) to floor((max − o)/U).
+    const int64_t x0 = std::max<int64_t>(pmin.x, -floorDiv(o.x - minX, U));
+    const int64_t x1 = std::min<int64_t>(pmax.x, floorDiv(maxX - o.x, U));
+    const int64_t y0 = std::max<int64_t>(pmin.y, -floorDiv(o.y - minY, U));
+    const int64_t y1 = std::min<int64_t>(pmax.y, floorDiv(maxY - o.y, U));
+    if (x0 <= x1 && y0 <= y1) return true;
+  }
+  return false;
+}
+
 // The integer half of setup, from the snapped vertices: area, facing,
 // culling, pixel bounds, the vertex order of positive area (`order`) and
-// the edge functions (their `original` flags are left false).
+// the edge functions (their `original` flags are left false). With
+// `dropSampleless`, NoSample where mayCoverSample would be false.
 SetupOutcome setupEdges(const ClipSpace& space, const SampleGrid& grid, const glm::i64vec2 snapped[3],
-                        CullMode cull, int order[3], TriangleSetup* t) {
+                        CullMode cull, bool dropSampleless, int order[3], TriangleSetup* t) {
   const int64_t area2 = (snapped[1].x - snapped[0].x) * (snapped[2].y - snapped[0].y) -
                         (snapped[1].y - snapped[0].y) * (snapped[2].x - snapped[0].x);
   if (area2 == 0) return SetupOutcome::Degenerate;  // zero area after snapping: covers nothing
@@ -97,6 +123,13 @@ SetupOutcome setupEdges(const ClipSpace& space, const SampleGrid& grid, const gl
   t->pixelMax = {int(std::clamp<int64_t>(floorDiv(maxX, grid.unitsPerPixel), -1, space.width - 1)),
                  int(std::clamp<int64_t>(floorDiv(maxY, grid.unitsPerPixel), -1, space.height - 1))};
   if (t->pixelMin.x > t->pixelMax.x || t->pixelMin.y > t->pixelMax.y) return SetupOutcome::Offscreen;
+  // Most sub-pixel triangles hold no sample in their box: known before
+  // their edge functions are made.
+  const bool searched =
+      int64_t(t->pixelMax.x - t->pixelMin.x + 1) * (t->pixelMax.y - t->pixelMin.y + 1) * grid.spp <=
+      kSampleSearchLimit;
+  if (dropSampleless && searched && !boxHoldsSample(minX, maxX, minY, maxY, t->pixelMin, t->pixelMax, grid))
+    return SetupOutcome::NoSample;
 
   // Reorder to positive area: swap vertices 1 and 2 of front faces.
   order[0] = 0;
@@ -116,6 +149,7 @@ SetupOutcome setupEdges(const ClipSpace& space, const SampleGrid& grid, const gl
     e.bias = e.topLeft ? 0 : -1;
     e.original = false;
   }
+  if (dropSampleless && searched && !mayCoverSample(*t, grid)) return SetupOutcome::NoSample;
   return SetupOutcome::Ok;
 }
 
@@ -185,7 +219,7 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
     snapped[i] = {snapUnits(image[i].x, U), snapUnits(image[i].y, U)};
   }
   int order[3];
-  const SetupOutcome o = setupEdges(space, grid, snapped, cull, order, t);
+  const SetupOutcome o = setupEdges(space, grid, snapped, cull, false, order, t);
   if (o != SetupOutcome::Ok) return o;
   setupPlanes(grid, ds, v, image, order, t);
   return SetupOutcome::Ok;
@@ -302,13 +336,17 @@ struct VertexCodes {
   std::unique_ptr<uint8_t[]> outside;
   std::unique_ptr<Snapped[]> snapped;
 };
+static_assert(sizeof(uint8_t) + sizeof(VertexCodes::Snapped) == kSetupVertexCodeBytes);
 
 // Loads a triangle's world positions; false when its world area is zero
 // (isDegenerate in common/scene.h on the positions already loaded).
-bool loadTriangle(const Scene& scene, const glm::uvec3& idx, glm::dvec3 p[3]) {
+void loadPositions(const Scene& scene, const glm::uvec3& idx, glm::dvec3 p[3]) {
   p[0] = glm::dvec3(scene.positions[idx.x]);
   p[1] = glm::dvec3(scene.positions[idx.y]);
   p[2] = glm::dvec3(scene.positions[idx.z]);
+}
+bool loadTriangle(const Scene& scene, const glm::uvec3& idx, glm::dvec3 p[3]) {
+  loadPositions(scene, idx, p);
   return glm::cross(p[1] - p[0], p[2] - p[0]) != glm::dvec3(0.0);
 }
 
@@ -336,26 +374,38 @@ void setupChunkReference(const SetupContext& c, const SetupChunk& chunk, ChunkOu
 // triangle that needs no clipping are integer work on its vertices' codes
 // (its clip vertices are its own vertices, so setupTriangle would snap
 // them to the same positions); only a kept triangle is transformed again
-// for its planes.
+// for its planes. An instance without zero-area triangles (SPEC §1;
+// Instance::degenerateCount, which the loader and rebaseScene keep) skips
+// the world-area test, and its positions are loaded only for the
+// triangles kept or clipped.
 void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const SetupChunk& chunk,
                     ChunkOutput* out) {
   const Instance& inst = c.scene.instances[chunk.instance];
   const CullMode instanceCull = c.scene.materials[inst.material].doubleSided ? CullMode::None : c.cull;
   SetupCounters& n = out->counters;
-  out->setups.reserve(chunk.count / 4);  // most triangles of a dense mesh cover no sample
+  // One piece per triangle unless clipping splits it: the chunk buffers are
+  // small (at most kChunk setups) and reused through the heap.
+  out->setups.reserve(chunk.count);
+  // Reused: a kept setup has every field written below (setupEdges,
+  // setupPlanes), and most triangles are rejected before it is touched.
+  TriangleSetup t;
+  t.instance = chunk.instance;
+  t.fromClipping = false;
+  const bool anyDegenerate = inst.degenerateCount != 0;
   for (uint32_t k = chunk.first; k < chunk.first + chunk.count; ++k) {
     if (c.filter.candidates && !((*c.filter.candidates)[inst.firstTriangle + k] & c.filter.candidateBit))
       continue;
     ++n.trianglesIn;
     const glm::uvec3 idx = c.scene.triangles[inst.firstTriangle + k];
     glm::dvec3 p[3];
-    if (!loadTriangle(c.scene, idx, p)) {
+    if (anyDegenerate && !loadTriangle(c.scene, idx, p)) {
       ++n.degenerate;  // SPEC §1: zero world area covers nothing
       continue;
     }
     // Codes exist for the instance's own vertex range only.
     const glm::uvec3 local = idx - glm::uvec3(inst.firstVertex);
     if (local.x >= inst.vertexCount || local.y >= inst.vertexCount || local.z >= inst.vertexCount) {
+      if (!anyDegenerate) loadPositions(c.scene, idx, p);
       setupClipped(c, instanceCull, chunk.instance, k, p, out);
       continue;
     }
@@ -365,18 +415,17 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
       continue;
     }
     if (m0 | m1 | m2) {  // needs clipping
+      if (!anyDegenerate) loadPositions(c.scene, idx, p);
       setupClipped(c, instanceCull, chunk.instance, k, p, out);
       continue;
     }
-    TriangleSetup t;
-    t.instance = chunk.instance;
     t.triangle = k;
-    t.fromClipping = false;
     const glm::i64vec2 snapped[3] = {{codes.snapped[idx.x].x, codes.snapped[idx.x].y},
                                      {codes.snapped[idx.y].x, codes.snapped[idx.y].y},
                                      {codes.snapped[idx.z].x, codes.snapped[idx.z].y}};
     int order[3];
-    const SetupOutcome o = setupEdges(c.space, c.grid, snapped, instanceCull, order, &t);
+    const SetupOutcome o =
+        setupEdges(c.space, c.grid, snapped, instanceCull, !c.filter.keepSampleless, order, &t);
     if (o == SetupOutcome::Degenerate) {
       ++n.degenerate;  // zero area after snapping: sub-pixel sliver or edge-on
       continue;
@@ -389,10 +438,11 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
       ++n.outside;
       continue;
     }
-    if (!c.filter.keepSampleless && !mayCoverSample(t, c.grid)) {
+    if (o == SetupOutcome::NoSample) {
       ++n.noSample;
       continue;
     }
+    if (!anyDegenerate) loadPositions(c.scene, idx, p);
     const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
     t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
     const ClipVertex v[3] = {
@@ -410,6 +460,8 @@ void computeVertexCodes(const Scene& scene, const ClipSpace& space, const Sample
                         const std::vector<uint32_t>& instances, VertexCodes* codes) {
   codes->outside.reset(new uint8_t[scene.positions.size()]);
   codes->snapped.reset(new VertexCodes::Snapped[scene.positions.size()]);
+  adviseHugePages(codes->outside.get(), scene.positions.size());
+  adviseHugePages(codes->snapped.get(), scene.positions.size() * sizeof(VertexCodes::Snapped));
   struct Range {
     size_t begin, end;
   };

@@ -126,7 +126,9 @@ struct DepthSettings {
   double offsetFactor = 0.0, offsetUnits = 0.0;
 };
 
-enum class SetupOutcome { Ok, Degenerate, Culled, Offscreen };  // Offscreen: no pixel of the image
+// Offscreen: no pixel of the image. NoSample: covers no sample
+// (mayCoverSample false); only prepareTriangles' own steps tell it apart.
+enum class SetupOutcome { Ok, Degenerate, Culled, Offscreen, NoSample };
 
 // Pixel bounds of at most this many samples are searched for a covered
 // sample; larger ones are assumed to cover one (mayCoverSample).
@@ -180,13 +182,17 @@ struct TriangleFilter {
 //              steps.
 enum class SetupPath { Fast, Reference };
 
+// What the fast path holds per vertex while it runs: the outside planes (1
+// byte) and the snapped image position (2 × int32).
+constexpr size_t kSetupVertexCodeBytes = 9;
+
 // Transform (world → view in double), clip and set up every triangle of the
 // scene that passes `filter`, in scene order (instance, triangle; clipped
 // pieces in fan order), independently of the thread count. `cull` applies
 // to single-sided materials only. Memory: the result (capacity reserved
 // once for one setup per input triangle; pages never written cost no
-// memory), a few chunks in flight per thread, and on the fast path 9
-// bytes per vertex of the selected instances until it returns.
+// memory), a few chunks in flight per thread, and on the fast path
+// kSetupVertexCodeBytes per vertex until it returns.
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
                                             const SampleGrid& grid, const DepthSettings& depth, CullMode cull,
                                             TriangleFilter filter, SetupCounters* counters,

@@ -131,6 +131,8 @@ void addRasterParts(const Scene& scene, const RenderSettings& s, double layers, 
   const uint64_t triangles = scene.triangleCount();
   const uint64_t setupBytes = mulSat(triangles, sizeof(TriangleSetup));
   m.transient.add("triangle setups", setupBytes);
+  // The setup's per-vertex codes, alive while setups are made (raster/setup.h).
+  m.transient.add("setup vertex codes", mulSat(scene.positions.size(), kSetupVertexCodeBytes));
   m.transient.add("tile bins", mulSat(triangles, kBinBytesPerTriangle));
   m.transient.add("depth target", mulSat(samplesOf(s), kDepthTargetSampleBytes));
   if (s.raster.shadows == ShadowMode::Map && !scene.lights.empty()) {

@@ -33,7 +33,11 @@ inline uint32_t addMesh(Scene& scene, const std::vector<glm::vec3>& positions,
     scene.texcoords.push_back(glm::vec2(0.0f));
     scene.bounds.extend(glm::dvec3(p));
   }
-  for (const glm::uvec3& t : tris) scene.triangles.push_back(t + glm::uvec3(inst.firstVertex));
+  for (const glm::uvec3& t : tris) {
+    scene.triangles.push_back(t + glm::uvec3(inst.firstVertex));
+    // As the loader counts them (the rasterizer's fast setup relies on it).
+    if (isDegenerate(scene, scene.triangles.size() - 1)) ++inst.degenerateCount;
+  }
   scene.instances.push_back(inst);
   return uint32_t(scene.instances.size() - 1);
 }
