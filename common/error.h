@@ -7,20 +7,33 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace rastray {
 
 class InputError : public std::runtime_error {
  public:
   // what() reads "FILE: ELEMENT: MESSAGE" (ELEMENT may be empty, e.g. for
-  // a file that cannot be opened at all).
-  InputError(std::string file, std::string element, std::string message);
+  // a file that cannot be opened at all). Inline: the OpenImageIO module
+  // (common/oiio_module.h) throws it too.
+  InputError(std::string file, std::string element, std::string message)
+      : std::runtime_error(joinWhere(file, element, message)),
+        file_(std::move(file)),
+        element_(std::move(element)),
+        message_(std::move(message)) {}
 
   const std::string& file() const { return file_; }
   const std::string& element() const { return element_; }
   const std::string& message() const { return message_; }
 
  private:
+  static std::string joinWhere(const std::string& file, const std::string& element,
+                               const std::string& message) {
+    std::string s = file;
+    if (!element.empty()) s += ": " + element;
+    return s + ": " + message;
+  }
+
   std::string file_, element_, message_;
 };
 

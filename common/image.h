@@ -22,10 +22,14 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "common/error.h"
+#include "common/scene.h"
 
 namespace rastray {
 
@@ -43,8 +47,22 @@ struct FlatImage {
   bool hasColor = true;
 
   FlatImage() = default;
-  FlatImage(int w, int h);  // transparent black, +inf depth, kNoId ids
+  // Transparent black, +inf depth, kNoId ids. Inline: the OpenImageIO
+  // module (common/oiio_module.h) makes them too.
+  FlatImage(int w, int h)
+      : width(w),
+        height(h),
+        color(checkedPixels(w, h), glm::vec4(0.0f)),
+        depth(color.size(), std::numeric_limits<float>::infinity()),
+        instance(color.size(), kNoId),
+        triangle(color.size(), kNoId) {}
   size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
+
+ private:
+  static size_t checkedPixels(int w, int h) {
+    RASTRAY_CHECK(w >= 0 && h >= 0, std::to_string(w) + "x" + std::to_string(h));
+    return size_t(w) * size_t(h);
+  }
 };
 
 struct DeepSample {

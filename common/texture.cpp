@@ -3,10 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-
 #include "common/image.h"
+#include "common/oiio_module.h"
 
 namespace rastray {
 
@@ -45,13 +43,8 @@ MipLevel halve(const MipLevel& src) {
   MipLevel dst;
   dst.width = std::max(1, src.width / 2);
   dst.height = std::max(1, src.height / 2);
-  OIIO::ImageSpec srcSpec(src.width, src.height, 4, OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf in(srcSpec, const_cast<glm::vec4*>(src.texels.data()));
-  OIIO::ImageSpec dstSpec(dst.width, dst.height, 4, OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf out(dstSpec);
-  OIIO::ImageBufAlgo::resize(out, in, "box");
   dst.texels.resize(size_t(dst.width) * size_t(dst.height));
-  out.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, dst.texels.data());
+  oiioModule().resizeBox(src.width, src.height, src.texels.data(), dst.width, dst.height, dst.texels.data());
   return dst;
 }
 

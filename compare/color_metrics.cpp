@@ -1,11 +1,10 @@
 #include "compare/color_metrics.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include "common/oiio_module.h"
 
 namespace rastray {
 
@@ -37,46 +36,24 @@ uint32_t sampleCount(const DeepImage& image) {
   return spp;
 }
 
-OIIO::ImageBuf toImageBuf(const FlatImage& image) {
-  OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf buf(spec);
-  // glm::vec4 is four packed floats: the RGBA scanline layout OIIO expects.
-  static_assert(sizeof(glm::vec4) == 4 * sizeof(float), "vec4 must be packed RGBA");
-  if (!buf.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, image.color.data()))
-    throw std::runtime_error("OpenImageIO: " + buf.geterror());
-  return buf;
-}
-
 }  // namespace
 
 ColorMetrics compareColors(const FlatImage& a, const FlatImage& b) {
   ColorMetrics m;
   m.pixels = uint64_t(a.width) * uint64_t(a.height);
   if (m.pixels == 0) return m;
-  const OIIO::ImageBuf ba = toImageBuf(a), bb = toImageBuf(b);
-  // failthresh = warnthresh = 0: nfail counts every pixel that differs at all.
-  const OIIO::ImageBufAlgo::CompareResults c = OIIO::ImageBufAlgo::compare(ba, bb, 0.0f, 0.0f);
-  // CompareResults::error also reports "some pixel failed the threshold"
-  // (with a threshold of 0: any difference), so real errors are read from
-  // OpenImageIO's error state instead.
-  if (OIIO::has_error()) throw std::runtime_error("OpenImageIO compare: " + OIIO::geterror());
-  m.meanError = c.meanerror;
-  m.rmsError = c.rms_error;
+  const ImageDifference d = oiioModule().compareColors(a.width, a.height, a.color.data(), b.color.data(),
+                                                       float(m.yeeLuminance), float(m.yeeFieldOfView));
+  m.meanError = d.meanError;
+  m.rmsError = d.rmsError;
   // OIIO's PSNR for a zero RMS is not +inf in every version: state it here.
-  m.psnr = c.rms_error > 0.0 ? 20.0 * std::log10(1.0 / c.rms_error) : std::numeric_limits<double>::infinity();
-  m.maxError = c.maxerror;
-  if (c.maxerror > 0.0) {
-    m.maxX = c.maxx;
-    m.maxY = c.maxy;
-    m.maxChannel = c.maxc;
-  }
-  m.differingPixels = uint64_t(c.nfail);
-  OIIO::ImageBufAlgo::CompareResults yee;
-  const int failing =
-      OIIO::ImageBufAlgo::compare_Yee(ba, bb, yee, float(m.yeeLuminance), float(m.yeeFieldOfView));
-  if (failing < 0 || OIIO::has_error())
-    throw std::runtime_error("OpenImageIO compare_Yee: " + OIIO::geterror());
-  m.yeeFailingPixels = uint64_t(failing);
+  m.psnr = d.rmsError > 0.0 ? 20.0 * std::log10(1.0 / d.rmsError) : std::numeric_limits<double>::infinity();
+  m.maxError = d.maxError;
+  m.maxX = d.maxX;
+  m.maxY = d.maxY;
+  m.maxChannel = d.maxChannel;
+  m.differingPixels = d.differingPixels;
+  m.yeeFailingPixels = d.yeeFailingPixels;
   return m;
 }
 

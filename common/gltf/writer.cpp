@@ -7,10 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include "common/math_constants.h"
+#include "common/oiio_module.h"
 
 namespace rastray {
 
@@ -43,14 +41,7 @@ void append(std::vector<unsigned char>* bytes, const T* data, size_t count) {
 std::vector<unsigned char> encodePng(const GltfTexture& t) {
   if (t.width < 1 || t.height < 1 || t.rgb.size() != size_t(t.width) * size_t(t.height) * 3)
     throw std::runtime_error("gltf_writer: texture size does not match its pixels");
-  std::vector<unsigned char> png;
-  OIIO::Filesystem::IOVecOutput proxy(png);
-  auto out = OIIO::ImageOutput::create("texture.png", &proxy);
-  const OIIO::ImageSpec spec(t.width, t.height, 3, OIIO::TypeDesc::UINT8);
-  if (!out || !out->open("texture.png", spec) || !out->write_image(OIIO::TypeDesc::UINT8, t.rgb.data()) ||
-      !out->close())
-    throw std::runtime_error("gltf_writer: cannot encode a texture as PNG");
-  return png;
+  return oiioModule().encodePng(t.width, t.height, 3, t.rgb.data());
 }
 
 }  // namespace

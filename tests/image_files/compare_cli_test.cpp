@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/image.h"
-#include "frames.h"
+#include "tests/compare/frames.h"
 #include "tests/app/run_command.h"
 
 namespace rastray {

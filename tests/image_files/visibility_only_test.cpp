@@ -14,7 +14,7 @@
 
 #include "common/image.h"
 #include "common/scene.h"
-#include "frames.h"
+#include "tests/compare/frames.h"
 #include "tests/app/run_command.h"
 
 namespace rastray {

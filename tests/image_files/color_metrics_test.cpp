@@ -9,7 +9,7 @@
 #include <filesystem>
 
 #include "compare/maps.h"
-#include "frames.h"
+#include "tests/compare/frames.h"
 
 namespace rastray {
 namespace {
