@@ -14,6 +14,7 @@
 #include "common/error.h"
 #include "common/image.h"
 #include "common/interrupt.h"
+#include "common/oiio_module.h"
 
 namespace rastray {
 
@@ -57,6 +58,11 @@ int runRender(RenderCommandOptions& opt) {
   throwIfInterrupted();
   RenderSettings settings = opt.settings;
   settings.keepSamples = opt.deep;
+  // The file -o names is written through OpenImageIO, loaded on first use
+  // (common/oiio_module.h): load it before the estimate, so that its
+  // libraries count in the estimate's "resident now" and in the peak
+  // beside the frame, as when it was linked in.
+  oiioModule();
   // Before anything large is allocated: the frame and the encoder's
   // buffers for the file -o names, against --max-memory.
   const MemoryEstimate memory = estimateRenderCommandMemory(scene, settings,

@@ -58,7 +58,11 @@ EmbreeScene::EmbreeScene(const Scene& scene, const SceneAnalysis& analysis, Cull
                          RTCFilterFunctionN intersectFilter, RTCFilterFunctionN occludedFilter,
                          void* filterUserPtr) {
   device_ = rtcNewDevice(nullptr);
-  if (!device_) throw std::runtime_error("embree: cannot create a device");
+  // rtcGetDeviceError(nullptr) says why: out of memory under a memory
+  // limit (the crossover study's children), or an unsupported CPU.
+  if (!device_)
+    throw std::runtime_error(std::string("embree: cannot create a device: ") +
+                             errorName(rtcGetDeviceError(nullptr)));
   rtcSetDeviceErrorFunction(device_, &EmbreeScene::onError, this);
 
   scene_ = rtcNewScene(device_);
