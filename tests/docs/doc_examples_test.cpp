@@ -96,8 +96,9 @@ std::string runBlock(const Block& b, const fs::path& dir) {
   }
   std::string missing;
   if (!matchesSample(b.sample, out, err, &missing))
-    return b.file + ":" + std::to_string(b.line_number) + ": the output has no line shaped like the sample's\n  " +
-           missing + "\nstdout:\n" + out + "\nstderr:\n" + err;
+    return b.file + ":" + std::to_string(b.line_number) +
+           ": the output has no line shaped like the sample's\n  " + missing + "\nstdout:\n" + out +
+           "\nstderr:\n" + err;
   return "";
 }
 
@@ -110,21 +111,30 @@ std::string runServeBlock(const Block& b, const fs::path& dir) {
   static const std::regex address(R"(http://127\.0\.0\.1:(\d+)/)");
   std::smatch m;
   std::string printed;
+  int exited = -1;                 // the server's exit status if it stopped by itself
   for (int i = 0; i < 600; ++i) {  // at most 60 s to load the scenes
     printed = slurp(out);
     if (std::regex_search(printed, m, address)) break;
+    int status = 0;
+    if (::waitpid(server, &status, WNOHANG) == server) {
+      exited = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      break;
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
+  if (exited >= 0)
+    return "the server exited " + std::to_string(exited) + " before it listened:\n" + printed + slurp(err);
   std::string failure;
   if (m.empty()) failure = "the server printed no address:\n" + printed + slurp(err);
   int step = 0;
   for (size_t i = 1; i < b.commands.size() && failure.empty(); ++i) {
     const Command& c = b.commands[i];
-    const std::string line = std::regex_replace(c.line, std::regex(R"(127\.0\.0\.1:8080)"), "127.0.0.1:" + m[1].str());
+    const std::string line =
+        std::regex_replace(c.line, std::regex(R"(127\.0\.0\.1:8080)"), "127.0.0.1:" + m[1].str());
     const Result r = runShell(line, dir, step++);
     if (r.status != c.expected_status)
-      failure = b.file + ":" + std::to_string(c.line_number) + ": `" + line + "` exited " + std::to_string(r.status) +
-                "\n" + r.out + r.err;
+      failure = b.file + ":" + std::to_string(c.line_number) + ": `" + line + "` exited " +
+                std::to_string(r.status) + "\n" + r.out + r.err;
     for (const std::string& f : c.writes)
       if (failure.empty() && !fs::exists(dir / f)) failure = b.file + ": `" + line + "` did not write " + f;
   }
@@ -160,7 +170,8 @@ TEST_P(DocExample, RunsAsDocumented) {
         return;
       }
       if (failure.empty())
-        FAIL() << b.file << ":" << b.line_number << " works now: remove its `pending: " << b.reason << "` marker";
+        FAIL() << b.file << ":" << b.line_number << " works now: remove its `pending: " << b.reason
+               << "` marker";
       GTEST_SKIP() << "pending (" << b.reason << "): " << failure.substr(0, failure.find('\n'));
     }
     case BlockKind::Run: {
@@ -171,7 +182,8 @@ TEST_P(DocExample, RunsAsDocumented) {
     case BlockKind::Pending: {
       const std::string failure = runBlock(b, prepareDirectory());
       if (failure.empty())
-        FAIL() << b.file << ":" << b.line_number << " works now: remove its `pending: " << b.reason << "` marker";
+        FAIL() << b.file << ":" << b.line_number << " works now: remove its `pending: " << b.reason
+               << "` marker";
       GTEST_SKIP() << "pending (" << b.reason << "): " << failure.substr(0, failure.find('\n'));
     }
   }
@@ -239,9 +251,11 @@ TEST(DocExampleMarkers, ATextBlockNeedsAnExampleBefore) {
 }
 
 TEST(DocExampleMarkers, OverridesReplaceOrAppendValues) {
-  EXPECT_EQ(applyOverrides("rastray bench s --size 1920 1080 --frames 10 --peers", "--frames 1 --size 160 120"),
-            "rastray bench s --size 160 120 --frames 1 --peers");
-  EXPECT_EQ(applyOverrides("rastray stability --report r", "--case zfight"), "rastray stability --report r --case zfight");
+  EXPECT_EQ(
+      applyOverrides("rastray bench s --size 1920 1080 --frames 10 --peers", "--frames 1 --size 160 120"),
+      "rastray bench s --size 160 120 --frames 1 --peers");
+  EXPECT_EQ(applyOverrides("rastray stability --report r", "--case zfight"),
+            "rastray stability --report r --case zfight");
 }
 
 TEST(DocExampleMarkers, SamplesMatchByShapeNotByNumbers) {
@@ -249,7 +263,8 @@ TEST(DocExampleMarkers, SamplesMatchByShapeNotByNumbers) {
       "scene   size  spp  agree%\n"
       "cornell-box.gltf  160x120    4  99.9896\n";
   std::string missing;
-  EXPECT_TRUE(matchesSample({"scene size spp agree%", "...", "cornell-box.gltf 320x240 16 98.5"}, out, "", &missing))
+  EXPECT_TRUE(
+      matchesSample({"scene size spp agree%", "...", "cornell-box.gltf 320x240 16 98.5"}, out, "", &missing))
       << missing;
   // A renamed column, a missing row or rows out of order do not match.
   EXPECT_FALSE(matchesSample({"scene size spp agreement"}, out, "", &missing));
@@ -276,18 +291,22 @@ TEST(DocPages, LinksResolveAndTheReadmeFits) {
       std::string target = (*it)[1].str();
       if (target.rfind("http", 0) == 0 || target[0] == '#') continue;
       target = target.substr(0, target.find('#'));
-      EXPECT_TRUE(fs::exists(page.parent_path() / target)) << page.filename() << " links to missing " << target;
+      EXPECT_TRUE(fs::exists(page.parent_path() / target))
+          << page.filename() << " links to missing " << target;
     }
     if (page.filename() != "CONVENTIONS.md") {
-      EXPECT_EQ(text.find("SPEC §"), std::string::npos) << page.filename() << " cites SPEC §: link docs/CONVENTIONS.md";
+      EXPECT_EQ(text.find("SPEC §"), std::string::npos)
+          << page.filename() << " cites SPEC §: link docs/CONVENTIONS.md";
     }
-    EXPECT_EQ(text.find("../shared/"), std::string::npos) << page.filename() << " points outside the repository";
+    EXPECT_EQ(text.find("../shared/"), std::string::npos)
+        << page.filename() << " points outside the repository";
     static const std::regex history(R"(What changed for issue|Before this issue|\(issue \d+\)|issue \d+'s)");
     // PERFORMANCE.md belongs to the performance work, which rewords its
     // "Before this issue" line; until then it is the one known exception,
     // and the exception fails as soon as it is no longer needed.
     if (page.filename() == "PERFORMANCE.md")
-      EXPECT_TRUE(std::regex_search(text, history)) << "PERFORMANCE.md has no history left: drop its exception";
+      EXPECT_TRUE(std::regex_search(text, history))
+          << "PERFORMANCE.md has no history left: drop its exception";
     else
       EXPECT_FALSE(std::regex_search(text, history)) << page.filename() << " carries history";
     if (page.parent_path().filename() == "docs") {
