@@ -10,6 +10,7 @@ packages=(
   libembree-dev libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenimageio-dev openimageio-tools libopencv-core-dev libopenexr-dev
   libtbb-dev libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev
+  graphviz  # dot: scripts/architecture_graph.sh draws the library graph (docs/ARCHITECTURE.md)
   chromium  # the real-browser tests (crossval report, `rastray serve` page, headless), which CI must run, not skip
   libhwy-dev  # Highway: portable SIMD with run-time dispatch (shading, resolve, PNG encoding)
   libcpp-httplib-dev  # the HTTP server of `rastray serve`, the browser explorer
