@@ -91,7 +91,8 @@ std::shared_ptr<const Scene> SceneCache::loaded(const std::string& path) {
   // Through the render command's own loader and default settings, in the
   // file's frame (a fresh scene's origin is (0, 0, 0): --origin world
   // rebases nothing).
-  const RenderSettings world = renderSettingsFrom({"--origin", "world"});
+  RenderSettings world = renderSettingsFrom({"--origin", "world"});
+  if (loadBudget) world.memory = *loadBudget;
   auto scene = std::make_shared<const Scene>(loadSceneForRender(path, world));
   loaded_.insert(path, scene);
   return scene;
@@ -128,7 +129,7 @@ std::string SceneCache::preparedKey(const std::string& path, const RenderSetting
         "\x1f"
         "camera " +
         std::to_string(*overrides.camera);
-  key += "\x1flights " + settings.lights;
+  key += "\x1flights " + optionText(settings, "--lights");
   return key;
 }
 

@@ -119,7 +119,16 @@ struct ExplorerServer::Impl {
   std::mutex clientsMutex;
   std::map<std::string, uint64_t> latestSeq;  // per client, the newest request seen
 
-  explicit Impl(const ServeOptions& o) : options(o), access(o.scenes, o.root) {}
+  explicit Impl(const ServeOptions& o) : options(o), access(o.scenes, o.root) { cache.loadBudget = o.memory; }
+
+  // The request's settings under the server's --max-memory: a request may
+  // lower the limit, never raise it.
+  RenderSettings settingsOf(const RequestParameters& r) const {
+    RenderSettings s = renderSettings(r);
+    if (options.memory && (!s.isGiven("--max-memory") || s.memory.bytes > options.memory->bytes))
+      s.memory = *options.memory;
+    return s;
+  }
 
   void routes();
   void frame(const httplib::Request& req, httplib::Response& res, bool pngOnly);
@@ -230,7 +239,7 @@ json ExplorerServer::Impl::mapFrame(const RequestParameters& r, const std::strin
 void ExplorerServer::Impl::frame(const httplib::Request& req, httplib::Response& res, bool pngOnly) {
   const RequestParameters r = parseRequest(req.params, Endpoint::Frame);
   const std::string path = access.resolve(r.scene);
-  const RenderSettings settings = renderSettings(r);
+  const RenderSettings settings = settingsOf(r);
   noteRequest(r);
   std::lock_guard<std::mutex> lock(renderMutex);
   throwIfSuperseded(r);
@@ -251,7 +260,7 @@ void ExplorerServer::Impl::frame(const httplib::Request& req, httplib::Response&
 void ExplorerServer::Impl::explain(const httplib::Request& req, httplib::Response& res) {
   const RequestParameters r = parseRequest(req.params, Endpoint::Explain);
   const std::string path = access.resolve(r.scene);
-  const RenderSettings settings = renderSettings(r);
+  const RenderSettings settings = settingsOf(r);
   const int width = settings.camera.width(), height = settings.camera.height();
   if (r.x >= width || r.y >= height)
     throw HttpError(400, "x, y: pixel (" + std::to_string(r.x) + ", " + std::to_string(r.y) +
@@ -281,7 +290,7 @@ void ExplorerServer::Impl::sceneInfo(const httplib::Request& req, httplib::Respo
   // The size is checked by the render command's own parser.
   QueryParameters query = {{"scene", r.scene}};
   if (req.has_param("size")) query.emplace("size", req.get_param_value("size"));
-  const RenderSettings settings = renderSettings(parseRequest(query, Endpoint::Frame));
+  const RenderSettings settings = settingsOf(parseRequest(query, Endpoint::Frame));
   const std::string path = access.resolve(r.scene);
   std::lock_guard<std::mutex> lock(renderMutex);
   json j = sceneInfoJson(*cache.loaded(path), settings.camera.width(), settings.camera.height());

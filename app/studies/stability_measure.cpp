@@ -5,8 +5,6 @@
 #include <cstdio>
 #include <filesystem>
 
-#include <CLI/CLI.hpp>
-
 #include "common/error.h"
 #include "common/math_constants.h"
 #include "common/sampling.h"

@@ -42,8 +42,7 @@ std::vector<std::string> split(const std::string& text, const std::string& separ
 
 // What the render command knows about each of its options: how many values
 // it takes (0: a flag) and its row of the render-option table (nullptr for
-// --renderer). Read from a parser built by addRenderSettings itself, so the
-// sweep accepts exactly what `rastray render` accepts.
+// --renderer), so the sweep accepts exactly what `rastray render` accepts.
 struct OptionInfo {
   int arity = 1;
   const RenderOptionSpec* spec = nullptr;
@@ -51,15 +50,9 @@ struct OptionInfo {
 
 const std::map<std::string, OptionInfo>& optionInfo() {
   static const std::map<std::string, OptionInfo> info = [] {
-    CLI::App app;
-    RenderSettings settings;
-    addRenderSettings(app, settings, /*withRenderer=*/true);
     std::map<std::string, OptionInfo> m;
     m["--renderer"] = {1, nullptr};
-    for (const RenderOptionSpec& spec : renderOptionTable()) {
-      const CLI::Option* option = app.get_option(spec.name);
-      m[spec.name] = {option->get_items_expected_max(), &spec};
-    }
+    for (const RenderOptionSpec& spec : renderOptionTable()) m[spec.name] = {spec.arity, &spec};
     return m;
   }();
   return info;
@@ -100,9 +93,9 @@ OptionGroup varyGroup(const VaryAxis& axis, int index, const std::string& value)
       bad("--vary " + axis.name, "'" + value + "': a flag takes on or off");
     return g;
   }
-  g.values = arity == 1 ? std::vector<std::string>{value} : split(value, "x:");
-  if (int(g.values.size()) != arity ||
-      std::any_of(g.values.begin(), g.values.end(), [](const std::string& v) { return v.empty(); }))
+  const std::optional<std::vector<std::string>> values = splitOptionValue(value, arity);
+  if (values) g.values = *values;
+  if (!values)
     bad("--vary " + axis.name, "'" + value + "': needs " + std::to_string(arity) +
                                    " numbers joined by 'x' or ':' (e.g. " +
                                    (axis.name == "size" ? "160x120" : "1:2:3") + ")");

@@ -312,6 +312,45 @@ TEST_F(ServeTest, BadParametersGet400WithTheCommandsMessage) {
   }
 }
 
+// serve --max-memory limits every render; a request may lower the limit,
+// not raise it.
+TEST(ServeMemory, TheServersLimitHoldsForEveryRequest) {
+  serve::ServeOptions options;
+  options.scenes = {scenePath("cornell-box")};
+  options.port = 0;
+  options.memory = MemoryBudget::parse("100K");
+  serve::ExplorerServer server(options);
+  const int port = server.bind();
+  std::thread thread([&] { server.run(); });
+  httplib::Client client("127.0.0.1", port);
+  client.set_read_timeout(120, 0);
+  const std::string scene = "scene=" + httplib::detail::encode_query_param(scenePath("cornell-box"));
+  for (const std::string& extra : {std::string(""), std::string("&max-memory=8G")}) {
+    const auto r = client.Get(("/api/image?" + scene + "&size=16x12" + extra).c_str());
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 400) << extra;
+    EXPECT_NE(r->body.find("above the memory limit of 100.0 KiB"), std::string::npos) << r->body;
+  }
+  server.stop();
+  thread.join();
+}
+
+// One size syntax everywhere: 320x240 as `sweep --vary` writes it; the
+// first form, 320,240, reads the same.
+TEST_F(ServeTest, SizesReadWidthXHeight) {
+  for (const char* size : {"40x30", "40,30"}) {
+    const auto r = get("/api/frame?" + cornell() + "&size=" + size);
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << size << ": " << r->body;
+    EXPECT_EQ(json::parse(r->body)["size"], json::array({40, 30})) << size;
+  }
+  const auto bad = get("/api/frame?" + cornell() + "&size=40x");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("size: '40x': needs 2 values joined by 'x' (e.g. 320x240)"), std::string::npos)
+      << bad->body;
+}
+
 TEST_F(ServeTest, UnknownParameterGets400) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"/api/image?" + cornell() + "&colour=red", "unknown parameter 'colour'"},
