@@ -23,7 +23,7 @@ namespace {
 struct CompareCommandOptions {
   std::string a, b, scene;
   int spp = 0;
-  std::string depthFormat = toString(StoredDepthFormat::FloatReversed);
+  std::string depthFormat = toString(DepthFormat::FloatReversed);
   double edgeDistance = kDefaultEdgeDistance;
   CameraOptions camera;  // from renderCli, once the command line is parsed
   RenderOptionsCli renderCli;
@@ -66,7 +66,7 @@ int runCompare(CompareCommandOptions& opt) {
   in.scenePath = opt.scene;
   in.camera = opt.camera.overrides();
   in.spp = opt.spp;
-  in.depthFormat = *parseStoredDepthFormat(opt.depthFormat);  // CLI11 checked the spelling
+  in.depthFormat = *parseDepthFormat(opt.depthFormat);  // CLI11 checked the spelling
   in.edgeDistance = opt.edgeDistance;
   // Both files are in memory at once: each may take half the budget
   // (estimated from its header before decoding, common/image.h).
@@ -140,9 +140,10 @@ CommandRunner addCompareCommand(CLI::App& app) {
   cmd->add_option("--mismatch-map", opt->mismatchMap,
                   "Write the visibility-mismatch map coloured by class (PNG)");
   cmd->add_option("--depth-map", opt->depthMap, "Write the |dZ| heat map of agreeing hits (PNG)");
-  cmd->add_option("--max-memory", opt->maxMemory,
-                  "Refuse (exit 2) a file whose header says reading it needs more than half of this: bytes or "
-                  "K, M, G, T (default: 80% of physical memory)");
+  cmd->add_option(
+      "--max-memory", opt->maxMemory,
+      "Refuse (exit 2) a file whose header says reading it needs more than half of this: bytes or "
+      "K, M, G, T (default: 80% of physical memory)");
   return [opt, cmd]() -> int { return cmd->parsed() ? runCompare(*opt) : -1; };
 }
 

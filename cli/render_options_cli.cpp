@@ -49,7 +49,8 @@ std::vector<std::string> RenderOptionsCli::args() const {
     const size_t arity = size_t(e.spec->arity);
     for (size_t i = 0; i < e.values.size(); i += arity) {
       args.push_back(e.spec->name);
-      args.insert(args.end(), e.values.begin() + long(i), e.values.begin() + long(std::min(i + arity, e.values.size())));
+      args.insert(args.end(), e.values.begin() + long(i),
+                  e.values.begin() + long(std::min(i + arity, e.values.size())));
     }
   }
   return args;

@@ -93,9 +93,10 @@ CommandRunner addServeCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--root", opt->server.root,
                   "Directory whose glTF files (and nothing outside it) may be opened");
-  cmd->add_option("--max-memory", opt->maxMemory,
-                  "Refuse (HTTP 400) a scene load or render whose estimated peak memory exceeds this: bytes "
-                  "or K, M, G, T (default: 80% of physical memory); a request's max-memory may only lower it");
+  cmd->add_option(
+      "--max-memory", opt->maxMemory,
+      "Refuse (HTTP 400) a scene load or render whose estimated peak memory exceeds this: bytes "
+      "or K, M, G, T (default: 80% of physical memory); a request's max-memory may only lower it");
   return [opt, cmd]() -> int { return cmd->parsed() ? runServe(*opt) : -1; };
 }
 

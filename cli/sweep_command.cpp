@@ -142,6 +142,8 @@ int runSweep(const SweepOptions& opt) {
                        "an EXR reference shows one scene; give one scene (or --reference auto)");
     const sweep::Reference& r = references.referenceFor(cells.front());
     meta.reference = r.description;
+    if (!r.inexact.empty())
+      std::fprintf(stderr, "rastray sweep: warning: %s: %s\n", spec.reference.c_str(), r.inexact.c_str());
     for (const sweep::Cell& c : cells)
       if (c.settings.camera.width() != r.color.width || c.settings.camera.height() != r.color.height)
         throw InputError(spec.reference, "",

@@ -101,19 +101,22 @@ constexpr Choice<TextureFilter> kTextureFilters[] = {{"sampler", TextureFilter::
                                                      {"nearest", TextureFilter::Nearest},
                                                      {"bilinear", TextureFilter::Bilinear},
                                                      {"trilinear", TextureFilter::Trilinear}};
-constexpr Choice<RenderOrigin> kOrigins[] = {{"camera", RenderOrigin::Camera}, {"world", RenderOrigin::World}};
+constexpr Choice<RenderOrigin> kOrigins[] = {{"camera", RenderOrigin::Camera},
+                                             {"world", RenderOrigin::World}};
 constexpr Choice<RayOffsetMethod> kRayOffsets[] = {{"error-bound", RayOffsetMethod::ErrorBound},
                                                    {"float-ulps", RayOffsetMethod::FloatUlps}};
 constexpr Choice<CullMode> kCullModes[] = {
     {"none", CullMode::None}, {"back", CullMode::Back}, {"front", CullMode::Front}};
 constexpr Choice<ShadowMode> kShadowModes[] = {
     {"map", ShadowMode::Map}, {"rays", ShadowMode::Rays}, {"none", ShadowMode::None}};
-constexpr Choice<DepthFormat> kDepthFormats[] = {{"float-reversed", DepthFormat::FloatReversed},
-                                                 {"float", DepthFormat::Float},
-                                                 {"unorm24", DepthFormat::Unorm24},
-                                                 {"unorm16", DepthFormat::Unorm16}};
+// --depth-format: common/depth_formula.h spells the formats.
+DepthFormat parseDepthFormatOption(const std::string& value) {
+  if (const std::optional<DepthFormat> format = parseDepthFormat(value)) return *format;
+  badOption("--depth-format", "'" + value + "' is not one of float-reversed, float, unorm24, unorm16");
+}
 constexpr Choice<DepthFunc> kDepthFuncs[] = {{"less", DepthFunc::Less}, {"lequal", DepthFunc::LEqual}};
-constexpr Choice<ShadingRate> kShadingRates[] = {{"sample", ShadingRate::Sample}, {"pixel", ShadingRate::Pixel}};
+constexpr Choice<ShadingRate> kShadingRates[] = {{"sample", ShadingRate::Sample},
+                                                 {"pixel", ShadingRate::Pixel}};
 
 // --lights: nullopt for "all", else the indices to keep (sorted, unique;
 // empty for "none"). Checked against the scene by selectLights.
@@ -203,7 +206,7 @@ constexpr RendererSet kTraced = kRaytrace | kHybrid;
 
 // A row's parser and formatter as lambdas over the settings `s` and the
 // option's values `v`.
-#define RASTRAY_PARSE(...) [](RenderSettings & s, const Values& v) { __VA_ARGS__; }
+#define RASTRAY_PARSE(...) [](RenderSettings& s, const Values& v) { __VA_ARGS__; }
 #define RASTRAY_FORMAT(...) [](const RenderSettings& s) -> Values { __VA_ARGS__; }
 #define RASTRAY_NO_VALUE RASTRAY_FORMAT((void)s; return {})
 
@@ -242,8 +245,8 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
     {"--threads", kAllRenderers, OptionCondition::Always, "Worker threads (0: all cores)", 1, "1",
      RASTRAY_PARSE(s.threads = parseInt("--threads", v[0], 0, 1024)),
      RASTRAY_FORMAT(return {std::to_string(s.threads)})},
-    {"--debug-pixel", kAllRenderers, OptionCondition::Always, "Trace what each stage did at pixel X Y (stderr)",
-     2, "1 1",
+    {"--debug-pixel", kAllRenderers, OptionCondition::Always,
+     "Trace what each stage did at pixel X Y (stderr)", 2, "1 1",
      RASTRAY_PARSE(s.debugPixel = glm::ivec2(parseInt("--debug-pixel", v[0], INT32_MIN, INT32_MAX),
                                              parseInt("--debug-pixel", v[1], INT32_MIN, INT32_MAX))),
      RASTRAY_FORMAT(if (!s.debugPixel) return {};
@@ -275,15 +278,16 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
      RASTRAY_FORMAT(if (!s.shadows) return {}; return {nameOf(*s.shadows, kShadowModes)})},
     // Rasterized primary visibility.
     {"--depth-format", kRasterized, OptionCondition::Always, "float-reversed, float, unorm24 or unorm16", 1,
-     "unorm24", RASTRAY_PARSE(s.raster.depthFormat = pick("--depth-format", v[0], kDepthFormats)),
-     RASTRAY_FORMAT(return {nameOf(s.raster.depthFormat, kDepthFormats)})},
+     "unorm24", RASTRAY_PARSE(s.raster.depthFormat = parseDepthFormatOption(v[0])),
+     RASTRAY_FORMAT(return {toString(s.raster.depthFormat)})},
     {"--depth-func", kRasterized, OptionCondition::Always, "less or lequal", 1, "lequal",
      RASTRAY_PARSE(s.raster.depthFunc = pick("--depth-func", v[0], kDepthFuncs)),
      RASTRAY_FORMAT(return {nameOf(s.raster.depthFunc, kDepthFuncs)})},
     {"--polygon-offset", kRasterized, OptionCondition::Always, "FACTOR UNITS, as glPolygonOffset", 2, "1 1",
      RASTRAY_PARSE(s.raster.polygonOffsetFactor = float(parseDouble("--polygon-offset", v[0]));
                    s.raster.polygonOffsetUnits = float(parseDouble("--polygon-offset", v[1]))),
-     RASTRAY_FORMAT(return {formatFloat(s.raster.polygonOffsetFactor), formatFloat(s.raster.polygonOffsetUnits)})},
+     RASTRAY_FORMAT(
+         return {formatFloat(s.raster.polygonOffsetFactor), formatFloat(s.raster.polygonOffsetUnits)})},
     {"--transparency", kRasterized, OptionCondition::Always,
      "sorted, peel:N or exact (per-sample fragment lists)", 1, "sorted",
      RASTRAY_PARSE(parseTransparency(s, v[0])), RASTRAY_FORMAT(return {formatTransparency(s.raster)})},
@@ -302,7 +306,8 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
      "1 1",
      RASTRAY_PARSE(s.raster.shadowBiasConstant = float(parseDouble("--shadow-bias", v[0]));
                    s.raster.shadowBiasSlope = float(parseDouble("--shadow-bias", v[1]))),
-     RASTRAY_FORMAT(return {formatFloat(s.raster.shadowBiasConstant), formatFloat(s.raster.shadowBiasSlope)})},
+     RASTRAY_FORMAT(
+         return {formatFloat(s.raster.shadowBiasConstant), formatFloat(s.raster.shadowBiasSlope)})},
     // Traced rays.
     {"--max-depth", kTraced, OptionCondition::Always, "Deepest secondary ray (reflection/refraction)", 1, "4",
      RASTRAY_PARSE(s.shading.maxDepth = parseInt("--max-depth", v[0], 0, 64)),
@@ -415,9 +420,8 @@ std::optional<std::vector<std::string>> splitOptionValue(const std::string& valu
     else
       out.back() += c;
   }
-  if (int(out.size()) != arity || std::any_of(out.begin(), out.end(), [](const std::string& t) {
-        return t.empty();
-      }))
+  if (int(out.size()) != arity ||
+      std::any_of(out.begin(), out.end(), [](const std::string& t) { return t.empty(); }))
     return std::nullopt;
   return out;
 }
@@ -480,8 +484,8 @@ std::string renderOptionsMarkdown() {
     for (char& c : help)
       if (c == '|') c = '/';
     out += "| `" + std::string(spec.name) + "` | " + (spec.arity == 0 ? "flag" : std::to_string(spec.arity)) +
-           " | " + (shown.empty() ? "" : "`" + shown + "`") + " | " + describeWhereApplies(spec) + " | " + help +
-           " |\n";
+           " | " + (shown.empty() ? "" : "`" + shown + "`") + " | " + describeWhereApplies(spec) + " | " +
+           help + " |\n";
   }
   return out;
 }
@@ -514,7 +518,7 @@ void RenderSettings::finish() {
   // caster traces shadow rays always). raster.shadows is the rasterizer's
   // technique; with allRenderers, that of the rasterizer alone.
   const RendererKind rasterizing = allRenderers ? RendererKind::Raster : renderer;
-  const ShadowMode shadowMode = shadows ? *shadows
+  const ShadowMode shadowMode = shadows                               ? *shadows
                                 : rasterizing == RendererKind::Raster ? ShadowMode::Map
                                                                       : ShadowMode::Rays;
   const RendererSet shadowModeRenderers = shadowMode == ShadowMode::Rays ? kTraced : kRasterized;

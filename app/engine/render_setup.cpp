@@ -43,6 +43,15 @@ Scene loadSceneForRender(const std::string& path, const RenderSettings& settings
   return scene;
 }
 
+ClassifierSettings classifierSettings(const Scene& scene, const Camera& camera, DepthFormat depthFormat) {
+  ClassifierSettings c;
+  c.depthFormat = depthFormat;
+  c.planes = {true, camera.projection, camera.znear, camera.zfar};
+  c.scene = &scene;
+  c.camera = &camera;
+  return c;
+}
+
 std::string rayTreeText(const std::vector<TraceEvent>& events, glm::ivec2 pixel) {
   size_t rays = 0;
   for (const TraceEvent& e : events) rays += e.stage == TraceStage::Ray;

@@ -18,6 +18,7 @@
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "common/trace.h"
+#include "compare/classify.h"
 #include "raster/rasterizer.h"
 #include "raytrace/ray_caster.h"
 
@@ -96,6 +97,12 @@ Scene loadSceneForRender(const std::string& path, const RenderSettings& settings
 // options a trace sink of its own (explain).
 RenderRun renderScene(const Scene& scene, const RenderSettings& settings,
                       const MemoryEstimate* checked = nullptr);
+
+// How mismatches between renders of `scene` through `camera` are
+// classified: geometrically, against the depth buffer `depthFormat`
+// (the rasterizing renderer's --depth-format; float-reversed when only the
+// ray caster is compared). The one place every caller builds it.
+ClassifierSettings classifierSettings(const Scene& scene, const Camera& camera, DepthFormat depthFormat);
 
 // The ray caster's events of one pixel (TraceStage::Ray) as text under a
 // "ray tree of pixel (x, y): N rays" line; empty without ray events.

@@ -147,6 +147,9 @@ std::shared_ptr<PreparedFrame> SceneCache::frame(const std::string& path,
   frame->raster = settings.raster;
   frame->ray = settings.ray;
   frame->raster.keepSamples = frame->ray.keepSamples = false;
+  // A request's token is set for its render alone (renderPrepared's caller).
+  frame->settings.raster.cancel = frame->raster.cancel = nullptr;
+  frame->settings.ray.cancel = frame->ray.cancel = nullptr;
   frame->memory = estimateRenderMemory(*frame->scene, settings);
   checkMemory(frame->memory, settings.memory, frame->scene->path, "",
               describeRenderWork(settings, toString(settings.renderer)));

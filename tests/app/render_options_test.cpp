@@ -9,8 +9,8 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -315,10 +315,40 @@ TEST(RenderOptionsCommand, AcceptedWhereTheyApply) {
 // toArgs writes back what renderSettingsFrom read: every row's formatter
 // is its parser's inverse (the same values, bit for bit, floats included).
 TEST(RenderOptions, ToArgsGivesTheSameSettingsBack) {
-  const Args args = {"--renderer", "hybrid", "--size", "33", "17", "--spp", "4", "--eye", "0.1", "-2.5e-7",
-                     "3", "--yfov", "41.3", "--zfar", "inf", "--lights", "2,0", "--polygon-offset", "0.3",
-                     "-1", "--shadows", "map", "--shadow-bias", "0.001", "2", "--transparency", "peel:3",
-                     "--transparency-cutoff", "0.0001", "--max-memory", "3G", "--cull", "front", "--halo",
+  const Args args = {"--renderer",
+                     "hybrid",
+                     "--size",
+                     "33",
+                     "17",
+                     "--spp",
+                     "4",
+                     "--eye",
+                     "0.1",
+                     "-2.5e-7",
+                     "3",
+                     "--yfov",
+                     "41.3",
+                     "--zfar",
+                     "inf",
+                     "--lights",
+                     "2,0",
+                     "--polygon-offset",
+                     "0.3",
+                     "-1",
+                     "--shadows",
+                     "map",
+                     "--shadow-bias",
+                     "0.001",
+                     "2",
+                     "--transparency",
+                     "peel:3",
+                     "--transparency-cutoff",
+                     "0.0001",
+                     "--max-memory",
+                     "3G",
+                     "--cull",
+                     "front",
+                     "--halo",
                      "--wireframe"};
   const RenderSettings a = renderSettingsFrom(args);
   const Args written = toArgs(a);
@@ -332,10 +362,11 @@ TEST(RenderOptions, ToArgsGivesTheSameSettingsBack) {
   EXPECT_EQ(b.raster.peelLayers, 3);
   EXPECT_EQ(b.memory.bytes, 3ull << 30);
   EXPECT_EQ(*b.keptLights, (std::vector<size_t>{0, 2}));
-  EXPECT_EQ(joined(toArgs(a, {"--max-memory"})),
-            " --renderer hybrid --eye 0.1 -2.5e-07 3 --yfov 41.3 --zfar inf --size 33 17 --spp 4 --lights 0,2 "
-            "--cull front --shadows map --polygon-offset 0.3 -1 --transparency peel:3 --wireframe --halo "
-            "--shadow-bias 0.001 2 --transparency-cutoff 0.0001");
+  EXPECT_EQ(
+      joined(toArgs(a, {"--max-memory"})),
+      " --renderer hybrid --eye 0.1 -2.5e-07 3 --yfov 41.3 --zfar inf --size 33 17 --spp 4 --lights 0,2 "
+      "--cull front --shadows map --polygon-offset 0.3 -1 --transparency peel:3 --wireframe --halo "
+      "--shadow-bias 0.001 2 --transparency-cutoff 0.0001");
   // Given twice, or not a render option: refused, naming it.
   auto error = finishWith({"--spp", "4", "--spp", "8"});
   ASSERT_TRUE(error);

@@ -4,8 +4,10 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -429,6 +431,28 @@ TEST_F(ServeTest, RequestsForAnotherHostNameAreRefused) {
   // A page elsewhere whose DNS name is rebound to 127.0.0.1 is refused.
   EXPECT_EQ(get("/api/scenes", "attacker.example:80")->status, 403);
   EXPECT_EQ(get("/api/scenes", "localhost:" + std::to_string(port_))->status, 200);
+}
+
+// A request superseded while it renders stops rendering (at its next
+// tile) and answers 409: the first render here would take minutes on two
+// cores (2048x2048 at 64 spp, ray cast), so a 409 after the newer request
+// arrived can only come from the cancelled render; without cancellation it
+// would run to the end and answer 200.
+TEST_F(ServeTest, RequestSupersededWhileRenderingStops) {
+  const std::string slow =
+      "/api/image?" + cornell() + "&renderer=raytrace&size=2048x2048&spp=64&client=page9&seq=1";
+  std::optional<httplib::Result> first;
+  std::thread thread([&] { first = get(slow); });
+  // Long enough for the first request to be rendering (its scene loads in
+  // milliseconds); the newer one then waits for the render lock.
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  const auto second = get("/api/image?" + cornell() + "&size=16x12&client=page9&seq=2");
+  thread.join();
+  ASSERT_TRUE(first && *first);
+  EXPECT_EQ((*first)->status, 409) << (*first)->body;
+  EXPECT_EQ((*first)->body, "superseded by a newer request while rendering\n");
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->status, 200) << second->body;
 }
 
 TEST_F(ServeTest, OlderRequestOfTheSameClientIsSuperseded) {
