@@ -284,11 +284,11 @@ TEST_F(ServeTest, ExplainReturnsTheExplanationAndTheRayTreeOnTheImage) {
 TEST_F(ServeTest, BadParametersGet400WithTheCommandsMessage) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"/api/image?" + cornell() + "&spp=9", "spp: 9 is not supported"},
-      {"/api/image?" + cornell() + "&spp=abc", "--spp"},
-      {"/api/image?" + cornell() + "&size=0,10", "--size"},
-      {"/api/image?" + cornell() + "&size=20000,10", "--size"},
+      {"/api/image?" + cornell() + "&spp=abc", "spp: 'abc' is not an integer"},
+      {"/api/image?" + cornell() + "&size=0,10", "size: '0' is not in [1, 16384]"},
+      {"/api/image?" + cornell() + "&size=20000,10", "size: '20000' is not in [1, 16384]"},
       {"/api/image?" + cornell() + "&size=10", "size: '10': needs 2 values"},
-      {"/api/image?" + cornell() + "&max-depth=65&renderer=raytrace", "--max-depth"},
+      {"/api/image?" + cornell() + "&max-depth=65&renderer=raytrace", "max-depth: '65' is not in [0, 64]"},
       {"/api/image?" + cornell() + "&renderer=vulkan", "renderer: 'vulkan' is not one of"},
       {"/api/image?" + cornell() + "&renderer=raytrace&shadow-map-size=512",
        "shadow-map-size: applies to raster"},
