@@ -17,6 +17,7 @@
 #include "app/bench/terrain_scene.h"
 #include "app/report/csv.h"
 #include "cli/commands.h"
+#include "cli/render_options_cli.h"
 #include "common/error.h"
 #include "common/interrupt.h"
 
@@ -34,7 +35,8 @@ struct BenchCommandOptions {
   bool peers = false;
   int rounds = 3;
   std::string peersCsvPath;
-  RenderSettings settings;
+  RenderSettings settings;  // from renderCli, once the command line is parsed
+  RenderOptionsCli renderCli;
 };
 
 // "terrain:N": the crossover study's generated terrain of N triangles
@@ -182,7 +184,7 @@ void makeParentFolder(const std::string& path) {
 }
 
 int runBenchCommand(BenchCommandOptions& opt) {
-  opt.settings.finish();
+  opt.settings = opt.renderCli.settings(/*allRenderers=*/false);
   if (opt.frames < 1) throw InputError("command line", "--frames", "must be at least 1");
   for (const std::string* path : {&opt.csvPath, &opt.peersCsvPath, &opt.jsonPath})
     if (!path->empty()) makeParentFolder(*path);
@@ -309,7 +311,7 @@ CommandRunner addBenchCommand(CLI::App& app) {
   cmd->add_option("--peers-csv", opt->peersCsvPath, "With --peers: append one row per peer to this CSV file")
       ->needs(peers);
   cmd->add_option("--csv", opt->csvPath, "Append one row to this CSV file (a header first when it is new)");
-  addRenderSettings(*cmd, opt->settings);
+  opt->renderCli.add(*cmd, /*withRenderer=*/true);
   return [opt, cmd]() -> int { return cmd->parsed() ? runBenchCommand(*opt) : -1; };
 }
 

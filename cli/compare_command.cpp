@@ -10,6 +10,7 @@
 
 #include "app/engine/cli_options.h"
 #include "cli/commands.h"
+#include "cli/render_options_cli.h"
 #include "common/error.h"
 #include "common/memory_budget.h"
 #include "compare/compare_files.h"
@@ -22,9 +23,10 @@ namespace {
 struct CompareCommandOptions {
   std::string a, b, scene;
   int spp = 0;
-  std::string depthFormat = toString(StoredDepthFormat::FloatReversed);
+  std::string depthFormat = toString(DepthFormat::FloatReversed);
   double edgeDistance = kDefaultEdgeDistance;
-  CameraOptions camera;
+  CameraOptions camera;  // from renderCli, once the command line is parsed
+  RenderOptionsCli renderCli;
   double minAgreement = 0.0, failRms = 0.0;
   uint64_t maxGenuine = 0;
   CLI::Option *minAgreementOption = nullptr, *maxGenuineOption = nullptr, *failRmsOption = nullptr;
@@ -45,7 +47,8 @@ void requireColorFor(const CompareResult& result, const CompareCommandOptions& o
     throw InputError("command line", option, "cannot apply: colour skipped (" + result.colorSkipped + ")");
 }
 
-int runCompare(const CompareCommandOptions& opt) {
+int runCompare(CompareCommandOptions& opt) {
+  opt.camera = opt.renderCli.settings(/*allRenderers=*/false).camera;
   // Camera options other than the planes only make sense with the scene's
   // camera; silently ignoring them would misstate the classification.
   if (opt.scene.empty()) {
@@ -63,7 +66,7 @@ int runCompare(const CompareCommandOptions& opt) {
   in.scenePath = opt.scene;
   in.camera = opt.camera.overrides();
   in.spp = opt.spp;
-  in.depthFormat = *parseStoredDepthFormat(opt.depthFormat);  // CLI11 checked the spelling
+  in.depthFormat = *parseDepthFormat(opt.depthFormat);  // CLI11 checked the spelling
   in.edgeDistance = opt.edgeDistance;
   // Both files are in memory at once: each may take half the budget
   // (estimated from its header before decoding, common/image.h).
@@ -71,6 +74,12 @@ int runCompare(const CompareCommandOptions& opt) {
       opt.maxMemory.empty() ? MemoryBudget::machineDefault() : MemoryBudget::parse(opt.maxMemory);
   in.maxImageBytes = budget.bytes / 2;
   const CompareResult result = compareFiles(in);
+  if (opt.renderCli.given("--size") &&
+      (result.visibility.width != opt.camera.width() || result.visibility.height != opt.camera.height()))
+    throw InputError("command line", "--size",
+                     std::to_string(opt.camera.width()) + "x" + std::to_string(opt.camera.height()) +
+                         " is not the files' size, " + std::to_string(result.visibility.width) + "x" +
+                         std::to_string(result.visibility.height));
 
   Thresholds t;
   if (opt.minAgreementOption->count()) t.minAgreement = opt.minAgreement;
@@ -105,9 +114,9 @@ CommandRunner addCompareCommand(CLI::App& app) {
                   "The glTF scene both files show: classify edges geometrically (else image-space only)");
   cmd->add_option("--spp", opt->spp, "Samples per pixel the files were rendered with (needed with --scene)")
       ->check(CLI::PositiveNumber);
-  opt->camera.addTo(*cmd);
-  // The image size is the files' own.
-  cmd->remove_option(cmd->get_option("--size"));
+  // The camera options the files were rendered with; --size is the files'
+  // own, and when given must be theirs.
+  opt->renderCli.add(*cmd, /*withRenderer=*/false, RenderOptionsCli::Rows::Camera);
   cmd->add_option(
          "--depth-format", opt->depthFormat,
          "Depth buffer whose resolution decides a depth tie: float-reversed (default), float, unorm24, "
@@ -131,9 +140,10 @@ CommandRunner addCompareCommand(CLI::App& app) {
   cmd->add_option("--mismatch-map", opt->mismatchMap,
                   "Write the visibility-mismatch map coloured by class (PNG)");
   cmd->add_option("--depth-map", opt->depthMap, "Write the |dZ| heat map of agreeing hits (PNG)");
-  cmd->add_option("--max-memory", opt->maxMemory,
-                  "Refuse (exit 2) a file whose header says reading it needs more than half of this: bytes or "
-                  "K, M, G, T (default: 80% of physical memory)");
+  cmd->add_option(
+      "--max-memory", opt->maxMemory,
+      "Refuse (exit 2) a file whose header says reading it needs more than half of this: bytes or "
+      "K, M, G, T (default: 80% of physical memory)");
   return [opt, cmd]() -> int { return cmd->parsed() ? runCompare(*opt) : -1; };
 }
 

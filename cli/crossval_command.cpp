@@ -20,6 +20,7 @@
 #include "app/crossval/explain.h"
 #include "app/engine/render_setup.h"
 #include "cli/commands.h"
+#include "cli/render_options_cli.h"
 #include "common/error.h"
 #include "common/image.h"
 #include "common/interrupt.h"
@@ -36,7 +37,8 @@ struct CrossvalOptions {
   double minAgreement = 0.0;
   uint64_t maxGenuine = 0;
   double maxHybridError = 1e-5;
-  RenderSettings settings;
+  RenderSettings settings;  // from renderCli, once the command line is parsed
+  RenderOptionsCli renderCli;
 };
 
 // The failure lines of one scene under the thresholds.
@@ -142,7 +144,7 @@ std::string finishedAccount(const CrossvalOptions& opt,
 }
 
 int runCrossval(CrossvalOptions& opt) {
-  opt.settings.finish();
+  opt.settings = opt.renderCli.settings(/*allRenderers=*/true);
   if (opt.resume && opt.reportDir.empty())
     throw InputError("command line", "--resume", "needs --report DIR: the folder of the run to finish");
   std::unique_ptr<tbb::global_control> threads;
@@ -261,7 +263,7 @@ CommandRunner addCrossvalCommand(CLI::App& app) {
   cmd->add_option("--max-hybrid-error", opt->maxHybridError,
                   "Fail (exit 1) when hybrid and ray-cast colours differ by more where their hits agree")
       ->capture_default_str();
-  addRenderSettings(*cmd, opt->settings, /*withRenderer=*/false);
+  opt->renderCli.add(*cmd, /*withRenderer=*/false);
   return [opt, cmd]() -> int { return cmd->parsed() ? runCrossval(*opt) : -1; };
 }
 

@@ -7,6 +7,7 @@
 
 #include "app/crossval/explain.h"
 #include "cli/commands.h"
+#include "cli/render_options_cli.h"
 #include "common/error.h"
 
 namespace rastray {
@@ -17,11 +18,12 @@ struct ExplainOptions {
   std::string scenePath;
   int x = 0, y = 0;
   bool json = false;
-  RenderSettings settings;
+  RenderSettings settings;  // from renderCli, once the command line is parsed
+  RenderOptionsCli renderCli;
 };
 
 int runExplain(ExplainOptions& opt) {
-  opt.settings.finish();
+  opt.settings = opt.renderCli.settings(/*allRenderers=*/true);
   const Scene scene = loadSceneForRender(opt.scenePath, opt.settings);
   if (opt.x < 0 || opt.y < 0 || opt.x >= opt.settings.camera.width() || opt.y >= opt.settings.camera.height())
     throw InputError(
@@ -47,7 +49,7 @@ CommandRunner addExplainCommand(CLI::App& app) {
   cmd->add_option("y", opt->y, "Pixel row (0 = top)")->required();
   cmd->add_flag("--json", opt->json,
                 "Print the hits and every trace event as JSON (schema rastray.explain) for programs");
-  addRenderSettings(*cmd, opt->settings, /*withRenderer=*/false);
+  opt->renderCli.add(*cmd, /*withRenderer=*/false);
   return [opt, cmd]() -> int { return cmd->parsed() ? runExplain(*opt) : -1; };
 }
 

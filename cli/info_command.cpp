@@ -9,6 +9,7 @@
 
 #include "app/engine/cli_options.h"
 #include "cli/commands.h"
+#include "cli/render_options_cli.h"
 #include "common/analysis.h"
 #include "common/camera.h"
 #include "common/error.h"
@@ -23,7 +24,8 @@ namespace {
 struct InfoOptions {
   std::string scenePath;
   bool json = false;
-  CameraOptions camera;
+  CameraOptions camera;  // from renderCli, once the command line is parsed
+  RenderOptionsCli renderCli;
 };
 
 struct MaterialCounts {
@@ -73,7 +75,8 @@ nlohmann::json number(double d) {
   return d;
 }
 
-int runInfo(const InfoOptions& opt) {
+int runInfo(InfoOptions& opt) {
+  opt.camera = opt.renderCli.settings(/*allRenderers=*/false).camera;
   const Scene scene = loadScene(opt.scenePath);
   const SceneAnalysis analysis = analyzeScene(scene);
   const Camera camera = makeCamera(scene, opt.camera.overrides(), opt.camera.width(), opt.camera.height());
@@ -238,7 +241,7 @@ CommandRunner addInfoCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("info", "Print what a scene holds, its camera, and the work it needs");
   cmd->add_option("scene", opt->scenePath, "glTF 2.0 file (.gltf or .glb)")->required();
   cmd->add_flag("--json", opt->json, "Print JSON instead of a table");
-  opt->camera.addTo(*cmd);
+  opt->renderCli.add(*cmd, /*withRenderer=*/false, RenderOptionsCli::Rows::Camera);
   return [opt, cmd]() -> int { return cmd->parsed() ? runInfo(*opt) : -1; };
 }
 

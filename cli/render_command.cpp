@@ -11,6 +11,7 @@
 #include "app/engine/memory_estimate.h"
 #include "app/engine/render_setup.h"
 #include "cli/commands.h"
+#include "cli/render_options_cli.h"
 #include "common/error.h"
 #include "common/image.h"
 #include "common/interrupt.h"
@@ -27,7 +28,8 @@ struct RenderCommandOptions {
   bool floatColor = false;
   bool stats = false;
   bool json = false;
-  RenderSettings settings;
+  RenderSettings settings;  // from renderCli, once the command line is parsed
+  RenderOptionsCli renderCli;
 };
 
 std::string lowerExtension(const std::string& path) {
@@ -39,7 +41,7 @@ std::string lowerExtension(const std::string& path) {
 }
 
 int runRender(RenderCommandOptions& opt) {
-  opt.settings.finish();
+  opt.settings = opt.renderCli.settings(/*allRenderers=*/false);
   // Check the output before the (possibly long) render.
   const std::string ext = lowerExtension(opt.output);
   if (ext != "png" && ext != "exr")
@@ -105,7 +107,7 @@ CommandRunner addRenderCommand(CLI::App& app) {
   cmd->add_flag("--float", opt->floatColor, "EXR colour as 32-bit float instead of half");
   cmd->add_flag("--stats", opt->stats, "Print the work counters and timings");
   cmd->add_flag("--json", opt->json, "Print counters, timings and passes as JSON");
-  addRenderSettings(*cmd, opt->settings);
+  opt->renderCli.add(*cmd, /*withRenderer=*/true);
   return [opt, cmd]() -> int { return cmd->parsed() ? runRender(*opt) : -1; };
 }
 

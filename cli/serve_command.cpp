@@ -17,6 +17,7 @@ namespace {
 
 struct ServeCommandOptions {
   serve::ServeOptions server;
+  std::string maxMemory;  // empty: MemoryBudget::machineDefault()
 };
 
 // SIGINT and SIGTERM stop the server cleanly, through the handlers every
@@ -52,6 +53,7 @@ class InterruptWatcher {
 int runServe(ServeCommandOptions& opt) {
   if (opt.server.scenes.empty() && opt.server.root.empty())
     throw InputError("command line", "SCENE", "name at least one scene, or a --root directory");
+  if (!opt.maxMemory.empty()) opt.server.memory = MemoryBudget::parse(opt.maxMemory);
   serve::ExplorerServer server(opt.server);
   bool ok = false;
   {
@@ -91,6 +93,10 @@ CommandRunner addServeCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--root", opt->server.root,
                   "Directory whose glTF files (and nothing outside it) may be opened");
+  cmd->add_option(
+      "--max-memory", opt->maxMemory,
+      "Refuse (HTTP 400) a scene load or render whose estimated peak memory exceeds this: bytes "
+      "or K, M, G, T (default: 80% of physical memory); a request's max-memory may only lower it");
   return [opt, cmd]() -> int { return cmd->parsed() ? runServe(*opt) : -1; };
 }
 

@@ -22,6 +22,7 @@
 #include "app/studies/sweep_report.h"
 #include "app/studies/sweep_table.h"
 #include "cli/commands.h"
+#include "cli/render_options_cli.h"
 #include "common/error.h"
 #include "common/image.h"
 #include "common/interrupt.h"
@@ -36,24 +37,12 @@ struct SweepOptions {
   int repeat = 3;
   bool resume = false;
   bool crossover = false, quick = false;  // the crossover study (app/studies/sweep_crossover.h)
-  RenderSettings settings;                // only to register the render options; read back as text
+  RenderOptionsCli renderCli;             // the render options given plainly, back as text
   CLI::App* cmd = nullptr;
 };
 
 // The render options given plainly, back in `rastray render` syntax.
-std::vector<std::string> plainRenderArgs(const SweepOptions& opt) {
-  std::vector<std::string> args;
-  std::vector<std::string> names = {"--renderer"};
-  for (const RenderOptionSpec& spec : renderOptionTable()) names.push_back(spec.name);
-  for (const std::string& name : names) {
-    const CLI::Option* option = opt.cmd->get_option(name);
-    if (option->count() == 0) continue;
-    args.push_back(name);
-    if (option->get_items_expected_max() == 0) continue;  // a flag
-    for (const std::string& value : option->results()) args.push_back(value);
-  }
-  return args;
-}
+std::vector<std::string> plainRenderArgs(const SweepOptions& opt) { return opt.renderCli.args(); }
 
 std::string file(const std::string& dir, const char* name) {
   return (std::filesystem::path(dir) / name).string();
@@ -153,6 +142,8 @@ int runSweep(const SweepOptions& opt) {
                        "an EXR reference shows one scene; give one scene (or --reference auto)");
     const sweep::Reference& r = references.referenceFor(cells.front());
     meta.reference = r.description;
+    if (!r.inexact.empty())
+      std::fprintf(stderr, "rastray sweep: warning: %s: %s\n", spec.reference.c_str(), r.inexact.c_str());
     for (const sweep::Cell& c : cells)
       if (c.settings.camera.width() != r.color.width || c.settings.camera.height() != r.color.height)
         throw InputError(spec.reference, "",
@@ -261,7 +252,7 @@ int runCrossoverStudy(const SweepOptions& opt) {
   crossover::CrossoverOptions o;
   o.reportDir = opt.reportDir;
   o.quick = opt.quick;
-  o.threads = opt.settings.threads;
+  o.threads = opt.renderCli.settings(/*allRenderers=*/false).threads;
   o.resume = opt.resume;
   return crossover::runCrossover(o);
 }
@@ -299,7 +290,7 @@ CommandRunner addSweepCommand(CLI::App& app) {
       "triangles at 320x240 to 3840x2160 (crossover.csv, crossover.json, plots)");
   cmd->add_flag("--quick", opt->quick,
                 "With --crossover: at most 1e5 triangles and 640x480 (about a minute)");
-  addRenderSettings(*cmd, opt->settings, /*withRenderer=*/true);
+  opt->renderCli.add(*cmd, /*withRenderer=*/true);
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return -1;
     if (opt->crossover) return runCrossoverStudy(*opt);

@@ -6,6 +6,27 @@
 
 namespace rastray {
 
+const char* toString(DepthFormat format) {
+  switch (format) {
+    case DepthFormat::FloatReversed:
+      return "float-reversed";
+    case DepthFormat::Float:
+      return "float";
+    case DepthFormat::Unorm24:
+      return "unorm24";
+    case DepthFormat::Unorm16:
+      return "unorm16";
+  }
+  return "?";
+}
+
+std::optional<DepthFormat> parseDepthFormat(const std::string& name) {
+  for (DepthFormat f :
+       {DepthFormat::FloatReversed, DepthFormat::Float, DepthFormat::Unorm24, DepthFormat::Unorm16})
+    if (name == toString(f)) return f;
+  return std::nullopt;
+}
+
 double conventionalWindowDepth(Projection projection, double znear, double zfar, double d) {
   if (projection == Projection::Orthographic) return (d - znear) / (zfar - znear);
   if (std::isinf(zfar)) return 1.0 - znear / d;
@@ -19,7 +40,7 @@ double reversedWindowDepth(Projection projection, double znear, double zfar, dou
   return znear * (zfar - d) / (d * (zfar - znear));
 }
 
-double storedWindowDepth(DepthEncoding encoding, Projection projection, double znear, double zfar, double d) {
+double storedWindowDepth(DepthFormat encoding, Projection projection, double znear, double zfar, double d) {
   return isReversed(encoding) ? reversedWindowDepth(projection, znear, zfar, d)
                               : conventionalWindowDepth(projection, znear, zfar, d);
 }
@@ -39,21 +60,20 @@ double float32Ulp(double x) {
   return std::ldexp(1.0, (e - 1) - 23);
 }
 
-double depthStep(DepthEncoding encoding, double stored) {
+double depthStep(DepthFormat encoding, double stored) {
   switch (encoding) {
-    case DepthEncoding::Unorm24:
+    case DepthFormat::Unorm24:
       return std::ldexp(1.0, -24);
-    case DepthEncoding::Unorm16:
+    case DepthFormat::Unorm16:
       return std::ldexp(1.0, -16);
-    case DepthEncoding::Float:
-    case DepthEncoding::FloatReversed:
+    case DepthFormat::Float:
+    case DepthFormat::FloatReversed:
       return float32Ulp(stored);
   }
   return std::numeric_limits<double>::infinity();
 }
 
-double viewDepthResolution(DepthEncoding encoding, Projection projection, double znear, double zfar,
-                           double d) {
+double viewDepthResolution(DepthFormat encoding, Projection projection, double znear, double zfar, double d) {
   if (!(d > 0.0) || std::isinf(d)) return std::numeric_limits<double>::infinity();
   const double stored = std::clamp(storedWindowDepth(encoding, projection, znear, zfar, d), 0.0, 1.0);
   return depthStep(encoding, stored) / windowDepthSlope(projection, znear, zfar, d);

@@ -1,6 +1,6 @@
-// The depth-buffer formulas: the one definition the rasterizer stores and
-// the compare tool reasons with (raster/depth.h and compare/classify.h
-// adapt their own format enums to DepthEncoding and call these).
+// The depth-buffer formats and formulas: the one definition the rasterizer
+// stores and the compare tool reasons with (raster/depth.h and
+// compare/classify.h call these with the same DepthFormat).
 //
 // Window depth. For view depth d (znear n, zfar f; f may be +inf for
 // perspective) the conventional window depth z in [0, 1] (near 0, far 1) is
@@ -30,14 +30,21 @@
 // every n (relative precision at every distance).
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include "common/scene.h"
 
 namespace rastray {
 
 // What a depth buffer stores and at which step (see above).
-enum class DepthEncoding { FloatReversed, Float, Unorm24, Unorm16 };
+enum class DepthFormat { FloatReversed, Float, Unorm24, Unorm16 };
+// "float-reversed", "float", "unorm24", "unorm16": the --depth-format spellings.
+const char* toString(DepthFormat format);
+std::optional<DepthFormat> parseDepthFormat(const std::string& name);
 
-inline bool isReversed(DepthEncoding e) { return e == DepthEncoding::FloatReversed; }
+// True when the format stores larger values for nearer surfaces (s = 1 − z).
+inline bool isReversed(DepthFormat format) { return format == DepthFormat::FloatReversed; }
 
 // Conventional window depth z (near 0, far 1) of view depth d.
 double conventionalWindowDepth(Projection projection, double znear, double zfar, double d);
@@ -45,7 +52,7 @@ double conventionalWindowDepth(Projection projection, double znear, double zfar,
 double reversedWindowDepth(Projection projection, double znear, double zfar, double d);
 // The value the encoding stores at view depth d, before clamping to [0, 1]
 // and rounding: z, or s for FloatReversed.
-double storedWindowDepth(DepthEncoding encoding, Projection projection, double znear, double zfar, double d);
+double storedWindowDepth(DepthFormat encoding, Projection projection, double znear, double zfar, double d);
 // |dz/dd| = |ds/dd| at view depth d.
 double windowDepthSlope(Projection projection, double znear, double zfar, double d);
 
@@ -54,11 +61,10 @@ double windowDepthSlope(Projection projection, double znear, double zfar, double
 double float32Ulp(double x);
 // The encoding's step at stored value s_f (not clamped: callers clamp as
 // the buffer does): 2^-24 / 2^-16 for unorm, float32Ulp(s_f) for float.
-double depthStep(DepthEncoding encoding, double stored);
+double depthStep(DepthFormat encoding, double stored);
 // The encoding's resolution in view depth at view depth d: the step at the
 // stored value (clamped to [0, 1], where the buffer saturates) divided by
 // |dz/dd|. +inf for d outside (0, inf).
-double viewDepthResolution(DepthEncoding encoding, Projection projection, double znear, double zfar,
-                           double d);
+double viewDepthResolution(DepthFormat encoding, Projection projection, double znear, double zfar, double d);
 
 }  // namespace rastray

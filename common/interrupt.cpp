@@ -77,6 +77,11 @@ void throwIfInterrupted() {
   if (signal != 0) throw Interrupted(signal, "nothing written");
 }
 
+void throwIfStopped(const CancelToken* token) {
+  throwIfInterrupted();
+  if (token && token->cancelled()) throw Cancelled();
+}
+
 void setInterruptForTesting(int signal) { requested.store(signal, std::memory_order_relaxed); }
 
 }  // namespace rastray

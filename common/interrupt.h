@@ -20,8 +20,15 @@
 // A second Ctrl-C or SIGTERM after the first ends the process at once with
 // the default action (the handler restores it when the first arrives): the
 // way out if a check is far away, at the price of what the checks protect.
+//
+// A render also stops on its own CancelToken (RasterOptions::cancel,
+// RayOptions::cancel), polled at the same checks: serve cancels a request's
+// render when a newer request of the same client arrives, and the render
+// throws Cancelled within about one tile per thread. A render without a
+// token (nullptr) stops on a signal alone.
 #pragma once
 
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -57,6 +64,33 @@ bool interruptRequested();
 int interruptSignal();
 // Throws Interrupted when a stop was requested.
 void throwIfInterrupted();
+
+// A request to stop one render; cancel() is thread-safe and may come from
+// any thread (serve's request handlers). Never reset: one token per render.
+class CancelToken {
+ public:
+  void cancel() { cancelled_.store(true, std::memory_order_relaxed); }
+  bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
+
+ private:
+  std::atomic<bool> cancelled_{false};
+};
+
+// Thrown by throwIfStopped() when the render's own token was cancelled (a
+// signal throws Interrupted: the whole command stops).
+class Cancelled : public std::runtime_error {
+ public:
+  Cancelled() : std::runtime_error("cancelled") {}
+};
+
+// Whether a render with this token (nullptr: none) should stop: a signal
+// arrived or the token was cancelled. Two relaxed loads: per tile, never
+// per sample.
+inline bool stopRequested(const CancelToken* token) {
+  return interruptRequested() || (token && token->cancelled());
+}
+// Throws Interrupted for a signal, else Cancelled for a cancelled token.
+void throwIfStopped(const CancelToken* token);
 
 // For tests in process: records `signal` as if it had arrived (0 clears
 // the request), without installing or invoking a handler.

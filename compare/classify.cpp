@@ -12,21 +12,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// The shared encoding of a stored format (common/depth_formula.h).
-DepthEncoding encodingOf(StoredDepthFormat format) {
-  switch (format) {
-    case StoredDepthFormat::FloatReversed:
-      return DepthEncoding::FloatReversed;
-    case StoredDepthFormat::Float:
-      return DepthEncoding::Float;
-    case StoredDepthFormat::Unorm24:
-      return DepthEncoding::Unorm24;
-    case StoredDepthFormat::Unorm16:
-      return DepthEncoding::Unorm16;
-  }
-  return DepthEncoding::FloatReversed;
-}
-
 }  // namespace
 
 const char* toString(MismatchClass c) {
@@ -61,42 +46,21 @@ const char* displayName(MismatchClass c) {
   return "?";
 }
 
-const char* toString(StoredDepthFormat f) {
-  switch (f) {
-    case StoredDepthFormat::FloatReversed:
-      return "float-reversed";
-    case StoredDepthFormat::Float:
-      return "float";
-    case StoredDepthFormat::Unorm24:
-      return "unorm24";
-    case StoredDepthFormat::Unorm16:
-      return "unorm16";
-  }
-  return "?";
-}
-
-std::optional<StoredDepthFormat> parseStoredDepthFormat(const std::string& name) {
-  for (StoredDepthFormat f : {StoredDepthFormat::FloatReversed, StoredDepthFormat::Float,
-                              StoredDepthFormat::Unorm24, StoredDepthFormat::Unorm16})
-    if (name == toString(f)) return f;
-  return std::nullopt;
-}
-
-std::string depthFormatFormula(StoredDepthFormat f) {
+std::string depthFormatFormula(DepthFormat f) {
   const char* planes =
       "view-depth resolution = step / |dz/dd|, |dz/dd| = n f/((f-n) d^2) (n/d^2 for f = inf), "
       "1/(f-n) ortho";
   switch (f) {
-    case StoredDepthFormat::FloatReversed:
+    case DepthFormat::FloatReversed:
       return std::string("float-reversed: stores 1-z; step = ulp32(1-z) = 2^(floor(log2(1-z))-23); ") +
              planes + "; without planes <= d*2^-23; tie when |dZ| <= resolution(D) + ulp32(D), D = max depth";
-    case StoredDepthFormat::Float:
+    case DepthFormat::Float:
       return std::string("float: stores z; step = ulp32(z) = 2^(floor(log2 z)-23); ") + planes +
              "; tie when |dZ| <= resolution(D) + ulp32(D), D = max depth";
-    case StoredDepthFormat::Unorm24:
+    case DepthFormat::Unorm24:
       return std::string("unorm24: stores z; step = 2^-24; ") + planes +
              "; tie when |dZ| <= resolution(D) + ulp32(D), D = max depth";
-    case StoredDepthFormat::Unorm16:
+    case DepthFormat::Unorm16:
       return std::string("unorm16: stores z; step = 2^-16; ") + planes +
              "; tie when |dZ| <= resolution(D) + ulp32(D), D = max depth";
   }
@@ -105,19 +69,19 @@ std::string depthFormatFormula(StoredDepthFormat f) {
 
 double ulp32(double x) { return float32Ulp(x); }
 
-double depthResolution(StoredDepthFormat format, const DepthPlanes& planes, double d) {
+double depthResolution(DepthFormat format, const DepthPlanes& planes, double d) {
   if (!(d > 0.0) || std::isinf(d)) return kInf;
-  if (!planes.known) return format == StoredDepthFormat::FloatReversed ? d * std::ldexp(1.0, -23) : kInf;
+  if (!planes.known) return format == DepthFormat::FloatReversed ? d * std::ldexp(1.0, -23) : kInf;
   // The formulas the rasterizer stores with: step at the stored value / |dz/dd|.
-  return viewDepthResolution(encodingOf(format), planes.projection, planes.znear, planes.zfar, d);
+  return viewDepthResolution(format, planes.projection, planes.znear, planes.zfar, d);
 }
 
-double depthTieTolerance(StoredDepthFormat format, const DepthPlanes& planes, double dA, double dB) {
+double depthTieTolerance(DepthFormat format, const DepthPlanes& planes, double dA, double dB) {
   const double d = std::max(dA, dB);
   return depthResolution(format, planes, d) + ulp32(d);
 }
 
-double planeTolerance(StoredDepthFormat format, const DepthPlanes& planes, double plane) {
+double planeTolerance(DepthFormat format, const DepthPlanes& planes, double plane) {
   return depthResolution(format, planes, plane) + ulp32(plane);
 }
 

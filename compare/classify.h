@@ -75,6 +75,7 @@
 #include <vector>
 
 #include "common/camera.h"
+#include "common/depth_formula.h"
 #include "common/scene.h"
 
 namespace rastray {
@@ -87,14 +88,11 @@ constexpr int kMismatchClassCount = 5;
 const char* toString(MismatchClass c);
 const char* displayName(MismatchClass c);
 
-// The depth buffer whose resolution decides a depth tie. Named apart from
-// the rasterizer's DepthFormat: compare/ knows neither renderer; the
-// spellings match its --depth-format values.
-enum class StoredDepthFormat { FloatReversed, Float, Unorm24, Unorm16 };
-const char* toString(StoredDepthFormat f);
-std::optional<StoredDepthFormat> parseStoredDepthFormat(const std::string& name);
+// The depth buffer whose resolution decides a depth tie is a DepthFormat
+// (common/depth_formula.h), the rasterizer's own: toString and
+// parseDepthFormat spell it as --depth-format does.
 // One line: the step formula of the format, for the report.
-std::string depthFormatFormula(StoredDepthFormat f);
+std::string depthFormatFormula(DepthFormat f);
 
 constexpr double kDefaultEdgeDistance = 1.0 / 16.0;  // pixels, see above
 
@@ -113,8 +111,8 @@ double ulp32(double x);
 // The format's resolution in view depth at view depth d (formula above);
 // +inf when it cannot be stated (planes unknown for a format that needs them,
 // d outside (0, inf)).
-double depthResolution(StoredDepthFormat format, const DepthPlanes& planes, double d);
-double depthTieTolerance(StoredDepthFormat format, const DepthPlanes& planes, double dA, double dB);
+double depthResolution(DepthFormat format, const DepthPlanes& planes, double d);
+double depthTieTolerance(DepthFormat format, const DepthPlanes& planes, double dA, double dB);
 
 // Bound on the error of the t a float ray–triangle test (Embree's: e1 = v0 −
 // v1, e2 = v2 − v0, Ng = e1 × e2, t = Ng·(v0 − O) / Ng·D) reports for the
@@ -125,7 +123,7 @@ double depthTieTolerance(StoredDepthFormat format, const DepthPlanes& planes, do
 // parallel to the plane or a degenerate triangle.
 double floatIntersectionError(const Scene& scene, uint32_t instance, uint32_t triangle, const Ray& ray,
                               double t);
-double planeTolerance(StoredDepthFormat format, const DepthPlanes& planes, double plane);
+double planeTolerance(DepthFormat format, const DepthPlanes& planes, double plane);
 
 // What one file says is visible at one sample and layer.
 struct HitRecord {
@@ -141,7 +139,7 @@ struct ImageSpaceEvidence {
 };
 
 struct ClassifierSettings {
-  StoredDepthFormat depthFormat = StoredDepthFormat::FloatReversed;
+  DepthFormat depthFormat = DepthFormat::FloatReversed;
   double edgeDistance = kDefaultEdgeDistance;  // pixels
   DepthPlanes planes;
   // Both or neither: with them, the geometric tests; without, image space.

@@ -155,7 +155,7 @@ CompareResult compareFiles(const CompareInputs& in) {
   } else if (in.camera.zfar) {
     throw InputError("command line", "--zfar", "needs --znear or --scene");
   }
-  if (!settings.planes.known && in.depthFormat != StoredDepthFormat::FloatReversed)
+  if (!settings.planes.known && in.depthFormat != DepthFormat::FloatReversed)
     throw InputError("command line", "--depth-format",
                      std::string(toString(in.depthFormat)) +
                          " needs the clipping planes to state its resolution: give --scene or --znear");

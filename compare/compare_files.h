@@ -25,7 +25,7 @@ struct CompareInputs {
   CameraOverrides
       camera;   // applied to the scene's camera; znear/zfar alone also set the planes without a scene
   int spp = 0;  // 0: not given
-  StoredDepthFormat depthFormat = StoredDepthFormat::FloatReversed;
+  DepthFormat depthFormat = DepthFormat::FloatReversed;
   double edgeDistance = kDefaultEdgeDistance;
   // Each file is refused when reading it would allocate more (readExr).
   uint64_t maxImageBytes = kNoReadLimit;

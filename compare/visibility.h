@@ -92,7 +92,7 @@ struct VisibilityReport {
   int width = 0, height = 0;
   int spp = 0;  // samples per pixel used (deep: given or inferred); 0: unknown (flat without --spp)
   bool geometric = false;  // classification used scene geometry (else image space)
-  StoredDepthFormat depthFormat = StoredDepthFormat::FloatReversed;
+  DepthFormat depthFormat = DepthFormat::FloatReversed;
   DepthPlanes planes;
   double edgeDistance = kDefaultEdgeDistance;
   AgreementCounts samples;  // flat: pixels

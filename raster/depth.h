@@ -41,9 +41,6 @@ namespace rastray {
 
 constexpr uint32_t kClearDepthKey = 0xFFFFFFFFu;
 
-// The shared encoding of a format (common/depth_formula.h).
-DepthEncoding encodingOf(DepthFormat format);
-
 // Window depth of view depth d as `format` stores it (z, or s reversed; see
 // above), before clamping and rounding.
 double windowDepth(DepthFormat format, Projection projection, double znear, double zfar, double d);
@@ -70,9 +67,6 @@ inline uint32_t depthKey(DepthFormat format, double z) {
   }
   return kClearDepthKey;
 }
-
-// True when the format stores larger z for nearer surfaces.
-inline bool isReversed(DepthFormat format) { return format == DepthFormat::FloatReversed; }
 
 // glPolygonOffset's r: the smallest difference the format resolves for a
 // primitive whose largest window depth is maxZ: 2^-bits for unorm (the
@@ -101,7 +95,6 @@ inline bool passesDepthTest(DepthFunc func, uint32_t key, uint64_t id, uint32_t 
 
 inline uint64_t packId(uint32_t instance, uint32_t triangle) { return (uint64_t(instance) << 32) | triangle; }
 
-const char* toString(DepthFormat format);
 const char* toString(DepthFunc func);
 
 }  // namespace rastray

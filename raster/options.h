@@ -4,12 +4,14 @@
 #pragma once
 
 #include "common/cull.h"
+#include "common/depth_formula.h"
+#include "common/interrupt.h"
 #include "common/shading.h"
 #include "common/trace.h"
 
 namespace rastray {
 
-enum class DepthFormat { FloatReversed, Float, Unorm24, Unorm16 };  // precision: depth.h
+// DepthFormat (what the depth buffer stores, its precision): common/depth_formula.h.
 // Equal depths are decided by (instance, triangle) as if submitted in that
 // order: Less keeps the lower id, LEqual lets the higher win (depth.h).
 enum class DepthFunc { Less, LEqual };
@@ -45,6 +47,9 @@ struct RasterOptions {
   // tile, setup and edge functions, coverage, depth and MASK tests, shading,
   // blend layers, final colours. Checked once per tile; no sink, no cost.
   TraceRequest trace;
+  // Stops the render at its next tile when cancelled (common/interrupt.h);
+  // nullptr: a signal alone stops it. Must outlive the render.
+  const CancelToken* cancel = nullptr;
 };
 
 }  // namespace rastray

@@ -136,14 +136,14 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   parallelFor(0, tiles.count(), [&](int tile) {
     // Ctrl-C (common/interrupt.h): the tiles not yet started are skipped,
     // and the unfinished image is thrown away below.
-    if (interruptRequested()) return;
+    if (stopRequested(options.cancel)) return;
     const size_t t = size_t(tile);
     const TileBins bins{opaqueBins[t], analysis.transparency ? &blendBins[t] : nullptr};
     const TileOutputs outputs{&out.image, options.keepSamples ? &deep[t] : nullptr,
                               options.keepSamples ? &deepCounts[t] : nullptr, hits};
     renderer.render(tiles.rect(tile), bins, &target, outputs, counters.local());
   });
-  throwIfInterrupted();
+  throwIfStopped(options.cancel);
   const double tileSeconds = secondsSince(start);
   out.timings.emplace_back("raster.tiles", tileSeconds);
   ThreadCounters total;

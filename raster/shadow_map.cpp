@@ -207,7 +207,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         };
       std::vector<std::vector<Attenuation>> perTile(size_t(tiles.count()));
       parallelFor(0, tiles.count(), [&](int tile) {
-        if (interruptRequested()) return;  // Ctrl-C: thrown below
+        if (stopRequested(options.cancel)) return;  // Ctrl-C or cancelled: thrown below
         DepthPassCounters dc;
         const TileRect rect = tiles.rect(tile);
         DepthOnlyTile depth(rect);
@@ -238,7 +238,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
           return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
         });
       });
-      throwIfInterrupted();
+      throwIfStopped(options.cancel);
       indexAttenuation(perTile, &map);
       attenuating_ += map.attenuation.size();
       perLight_[l].push_back(std::move(map));

@@ -152,14 +152,14 @@ RenderOutput renderPrimaryVisibility(const CasterState& state) {
     for (int t = range.begin(); t != range.end(); ++t) {
       // Ctrl-C (common/interrupt.h): the tiles not yet started are
       // skipped, and the unfinished image is thrown away below.
-      if (interruptRequested()) return;
+      if (stopRequested(options.cancel)) return;
       const int x0 = (t % tilesX) * size, y0 = (t / tilesX) * size;
       const Tile tile{x0, y0, std::min(x0 + size, camera.width), std::min(y0 + size, camera.height)};
       renderTile(state, tile, positions, centre, local, &out.image,
                  options.keepSamples ? &deep.tiles[size_t(t)] : nullptr, &deep.pixelCounts);
     }
   });
-  throwIfInterrupted();
+  throwIfStopped(options.cancel);
   const double tilesWall = secondsBetween(start, Clock::now());
   double primary = 0.0, shade = 0.0;
   for (const TileScratch& local : scratch) {

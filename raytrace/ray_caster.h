@@ -108,6 +108,7 @@
 #include "common/analysis.h"
 #include "common/camera.h"
 #include "common/cull.h"
+#include "common/interrupt.h"
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "common/shading.h"
@@ -146,6 +147,9 @@ struct RayOptions {
   // render() records the ray tree of trace.pixel (TraceStage::Ray events,
   // one per ray: rayTraceEvent) into trace.sink after the image.
   TraceRequest trace;
+  // Stops the render at its next tile when cancelled (common/interrupt.h);
+  // nullptr: a signal alone stops it. Must outlive the render.
+  const CancelToken* cancel = nullptr;
 };
 
 // One traced ray of a pixel's ray tree (RayCaster::traceDebugPixel), in

@@ -6,20 +6,6 @@
 
 namespace rastray {
 
-StoredDepthFormat storedDepthFormat(DepthFormat f) {
-  switch (f) {
-    case DepthFormat::FloatReversed:
-      return StoredDepthFormat::FloatReversed;
-    case DepthFormat::Float:
-      return StoredDepthFormat::Float;
-    case DepthFormat::Unorm24:
-      return StoredDepthFormat::Unorm24;
-    case DepthFormat::Unorm16:
-      return StoredDepthFormat::Unorm16;
-  }
-  return StoredDepthFormat::FloatReversed;
-}
-
 CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
                              const std::function<void(const std::string&)>& progress) {
   CrossvalResult r;
@@ -54,11 +40,7 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
   // their tiles themselves.
   throwIfInterrupted();
   say("compare");
-  ClassifierSettings classifier;
-  classifier.depthFormat = storedDepthFormat(settings.raster.depthFormat);
-  classifier.planes = {true, r.camera.projection, r.camera.znear, r.camera.zfar};
-  classifier.scene = &scene;
-  classifier.camera = &r.camera;
+  const ClassifierSettings classifier = classifierSettings(scene, r.camera, settings.raster.depthFormat);
   const FrameNames rasterNames{"raster", "raytrace"}, hybridNames{"hybrid", "raytrace"};
   r.rasterVsRay = compareVisibility(r.raster.output.samples, r.raytrace.output.samples, settings.spp,
                                     classifier, rasterNames);

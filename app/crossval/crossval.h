@@ -13,10 +13,6 @@
 
 namespace rastray {
 
-// The compare tool's name for the rasterizer's depth format (compare/
-// knows neither renderer).
-StoredDepthFormat storedDepthFormat(DepthFormat format);
-
 struct CrossvalResult {
   std::string scenePath;
   std::string name;  // file stem, for the report

@@ -252,19 +252,9 @@ CrossvalSummary summaryFromJson(const nlohmann::json& j, const std::string& file
 }
 
 std::vector<std::string> crossvalResultOptions(const RenderSettings& settings) {
-  std::vector<std::string> args;
-  const std::vector<RenderOptionSpec>& table = renderOptionTable();
-  for (size_t i = 0; i < table.size() && i < settings.cliOptions.size(); ++i) {
-    const std::string name = table[i].name;
-    const CLI::Option* option = settings.cliOptions[i];
-    // Neither the thread count (renders are bit-identical at any count)
-    // nor the memory limit changes what a scene's comparison finds.
-    if (!option || option->count() == 0 || name == "--threads" || name == "--max-memory") continue;
-    args.push_back(name);
-    if (option->get_items_expected_max() == 0) continue;  // a flag
-    for (const std::string& value : option->results()) args.push_back(value);
-  }
-  return args;
+  // Neither the thread count (renders are bit-identical at any count) nor
+  // the memory limit changes what a scene's comparison finds.
+  return toArgs(settings, {"--threads", "--max-memory"});
 }
 
 CrossvalRunRecord newCrossvalRun(const std::vector<std::string>& options) {

@@ -65,9 +65,8 @@ struct CrossvalRunRecord {
   std::string run;                   // differs between runs started afresh
 };
 
-// The render options that decide a scene's results, as given (after
-// addRenderSettings and parsing): every option of renderOptionTable() the
-// user gave but --threads and --max-memory.
+// The render options that decide a scene's results (toArgs): every option
+// of renderOptionTable() the user gave but --threads and --max-memory.
 std::vector<std::string> crossvalResultOptions(const RenderSettings& settings);
 // "--size 64 48 --spp 4", or "(no render option)".
 std::string describeOptions(const std::vector<std::string>& options);

@@ -210,7 +210,8 @@ void writeCrossvalIndex(const std::string& dir, const std::vector<CrossvalSummar
       "and hybrid (rasterized visibility, traced secondary rays) with identical camera, samples and "
       "shading, then compared sample by sample and layer by layer.</p>";
   b += "<p>" + std::to_string(settings.spp) + " spp, rasterizer depth format " +
-       escapeHtml(settings.depthFormat) + ", transparency " + escapeHtml(settings.transparency) + ".</p>";
+       escapeHtml(optionText(settings, "--depth-format")) + ", transparency " +
+       escapeHtml(optionText(settings, "--transparency")) + ".</p>";
   b += "<table><tr><th class=\"l\">scene</th><th>size</th><th>samples</th><th>layers</th><th>agree</th>";
   for (int c = 0; c < kMismatchClassCount; ++c)
     b += "<th>" + std::string(displayName(MismatchClass(c))) + "</th>";

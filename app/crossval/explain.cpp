@@ -61,12 +61,7 @@ PixelExplanation explainPixel(const Scene& scene, const RenderSettings& settings
   e.rayEvents = rayLog.events();
 
   // Hits side by side, with the mismatch class of each disagreement.
-  ClassifierSettings cs;
-  cs.depthFormat = storedDepthFormat(s.raster.depthFormat);
-  cs.planes = {true, raster.camera.projection, raster.camera.znear, raster.camera.zfar};
-  cs.scene = &scene;
-  cs.camera = &raster.camera;
-  MismatchClassifier classifier(cs);
+  MismatchClassifier classifier(classifierSettings(scene, raster.camera, s.raster.depthFormat));
   const auto positions = samplePositions(s.spp);
   const size_t p = size_t(y) * size_t(raster.camera.width) + size_t(x);
   for (uint32_t i = 0; i < positions.size(); ++i) {

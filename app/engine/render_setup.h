@@ -1,7 +1,6 @@
-// Render settings shared by `render`, `crossval` and `bench`: the options
-// of both renderers, their CLI, and one function that runs a renderer on a
-// scene (the composition point of hybrid rendering: app/ wires raster/ and
-// raytrace/, neither knows the other).
+// Rendering under RenderSettings (app/engine/render_options.h): one
+// function that runs a renderer on a scene (the composition point of hybrid
+// rendering: app/ wires raster/ and raytrace/, neither knows the other).
 #pragma once
 
 #include <memory>
@@ -9,10 +8,9 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "app/engine/cli_options.h"
+#include "app/engine/render_options.h"
 #include "common/analysis.h"
 #include "common/camera.h"
 #include "common/gltf/loader.h"
@@ -20,104 +18,11 @@
 #include "common/render_output.h"
 #include "common/scene.h"
 #include "common/trace.h"
+#include "compare/classify.h"
 #include "raster/rasterizer.h"
 #include "raytrace/ray_caster.h"
 
 namespace rastray {
-
-enum class RendererKind { Raster, Raytrace, Hybrid };
-const char* toString(RendererKind kind);
-
-// A set of renderers, one bit per RendererKind.
-using RendererSet = unsigned;
-constexpr RendererSet rendererBit(RendererKind kind) { return 1u << unsigned(kind); }
-constexpr RendererSet kAllRenderers = 0b111;
-
-// Within its renderers, when an option applies.
-enum class OptionCondition {
-  Always,
-  ShadowMaps,  // the renderer uses shadow maps (--shadows map)
-  Wireframe,   // --wireframe is given
-};
-
-struct RenderSettings;
-
-// One row of the render-option table: every option addRenderSettings
-// registers has one, and the table alone decides both the registration and
-// the refusal of an option the user gave where it does not apply.
-struct RenderOptionSpec {
-  const char* name;  // "--shadow-map-size"
-  RendererSet renderers;
-  OptionCondition condition;
-  const char* help;  // nullptr: a camera option, registered with its help by CameraOptions
-  // Registers the option bound to its field of `s`; nullptr for camera options.
-  CLI::Option* (*add)(CLI::App& cmd, RenderSettings& s, const std::string& name, const std::string& help);
-  const char* example;  // a value every renderer it applies to accepts ("" for flags)
-};
-
-// The table, in --help order.
-const std::vector<RenderOptionSpec>& renderOptionTable();
-// "raster and hybrid with --shadows map": where an option applies.
-std::string describeWhereApplies(const RenderOptionSpec& spec);
-
-struct RenderSettings {
-  RendererKind renderer = RendererKind::Raster;
-  int spp = 1;
-  CameraOptions camera;
-  RasterOptions raster;
-  RayOptions ray;
-  ShadingOptions shading;
-  int threads = 0;  // 0: all cores
-  bool keepSamples = false;
-  std::optional<glm::ivec2> debugPixel;
-
-  // Raw CLI values, turned into the structures above by finish().
-  std::string rendererName = "raster";
-  std::string transparency = "exact";
-  std::string shadows;  // empty: map for raster, rays for hybrid
-  std::string cull = "none", depthFormat = "float-reversed", depthFunc = "less", shadingRate = "sample";
-  std::string textureFilter = "sampler";
-  std::string origin = "camera", rayOffset = "error-bound";
-  std::string lights = "all";                     // --lights: all, none or indices "0,2"
-  std::optional<std::vector<size_t>> keptLights;  // set by finish(): nullopt keeps all
-  RenderOrigin renderOrigin = RenderOrigin::Camera;
-  std::vector<float> polygonOffset, shadowBias;
-  std::vector<int> debugPixelXY;
-  std::string maxMemory;  // empty: MemoryBudget::machineDefault()
-  MemoryBudget memory;    // set by finish(); loads and renders are refused above it
-
-  // Set by addRenderSettings: each table row's CLI option (its count()
-  // tells whether the user gave it), and whether the command runs every
-  // renderer (crossval, explain) rather than the one --renderer names.
-  std::vector<const CLI::Option*> cliOptions;
-  bool allRenderers = false;
-
-  // Validates combinations and fills the option structures; throws
-  // InputError("command line", option, message). An option the user gave
-  // must apply to the chosen renderer (with allRenderers: to at least one
-  // of them), even when the value given is its default.
-  void finish();
-
-  // Whether a table row applies to `kind` under these settings (after
-  // finish()). With allRenderers, hybrid traces shadow rays whatever
-  // --shadows says: crossval compares its colours with the ray caster's.
-  bool applies(const RenderOptionSpec& spec, RendererKind kind) const;
-  // The shadow technique `kind` uses under these settings (after finish()).
-  ShadowMode shadowModeFor(RendererKind kind) const;
-};
-
-// Registers --renderer (when `withRenderer`; crossval and explain run every
-// renderer), the camera options and every row of renderOptionTable().
-void addRenderSettings(CLI::App& cmd, RenderSettings& settings, bool withRenderer = true);
-
-// Render options exactly as the command line gives them to `rastray render`
-// (allRenderers false: "--renderer X" among them) or `crossval`
-// (allRenderers true): registered with addRenderSettings, parsed by CLI11,
-// checked and completed by RenderSettings::finish(). How the studies,
-// sweep cells and serve's requests build settings in process. Throws
-// InputError (file "command line") or CLI::ParseError on a bad list.
-// The result's cliOptions are cleared (they point into a parser that is gone).
-RenderSettings renderSettingsFrom(const std::vector<std::string>& args, bool allRenderers = false);
 
 // A scene made ready for frames under fixed settings: its analysis, the
 // camera and, for the ray caster and hybrid, the Embree scene (BVH), built
@@ -192,6 +97,12 @@ Scene loadSceneForRender(const std::string& path, const RenderSettings& settings
 // options a trace sink of its own (explain).
 RenderRun renderScene(const Scene& scene, const RenderSettings& settings,
                       const MemoryEstimate* checked = nullptr);
+
+// How mismatches between renders of `scene` through `camera` are
+// classified: geometrically, against the depth buffer `depthFormat`
+// (the rasterizing renderer's --depth-format; float-reversed when only the
+// ray caster is compared). The one place every caller builds it.
+ClassifierSettings classifierSettings(const Scene& scene, const Camera& camera, DepthFormat depthFormat);
 
 // The ray caster's events of one pixel (TraceStage::Ray) as text under a
 // "ray tree of pixel (x, y): N rays" line; empty without ray events.

@@ -6,8 +6,6 @@
 #include <cstdlib>
 #include <optional>
 
-#include <CLI/CLI.hpp>
-
 #include "app/engine/render_setup.h"
 #include "common/error.h"
 #include "common/sampling.h"
@@ -23,58 +21,25 @@ namespace {
 // x, y parameters.
 bool serverSets(const std::string& option) { return option == "--threads" || option == "--debug-pixel"; }
 
-// The command's parser, built by addRenderSettings itself: how many values
-// each option takes, its help and its default, exactly as `rastray render`.
-struct OptionParser {
-  CLI::App app;
-  RenderSettings settings;
-  OptionParser() { addRenderSettings(app, settings, /*withRenderer=*/true); }
-};
-
-const OptionParser& optionParser() {
-  static const OptionParser parser;
-  return parser;
-}
-
-const RenderOptionSpec* findOption(const std::string& name) {
-  for (const RenderOptionSpec& spec : renderOptionTable())
-    if (name == spec.name) return &spec;
-  return nullptr;
-}
-
-int arityOf(const RenderOptionSpec& spec) {
-  return optionParser().app.get_option(spec.name)->get_items_expected_max();
-}
-
-std::vector<std::string> splitCommas(const std::string& value) {
-  std::vector<std::string> out(1);
-  for (const char c : value) {
-    if (c == ',')
-      out.emplace_back();
-    else
-      out.back() += c;
-  }
-  return out;
-}
-
 // The tokens of one render option ("--size", "320", "240"); empty for a
 // flag switched off.
 std::vector<std::string> optionTokens(const RenderOptionSpec& spec, const std::string& name,
                                       const std::string& value) {
-  const int arity = arityOf(spec);
+  const int arity = spec.arity;
   if (arity == 0) {
     if (value == "off") return {};
     if (value != "on") badRequest(name + ": '" + value + "': a flag takes on or off");
     return {spec.name};
   }
   // One value is taken whole: it may hold commas of its own (--lights 0,2).
-  std::vector<std::string> tokens = arity == 1 ? std::vector<std::string>{value} : splitCommas(value);
-  if (int(tokens.size()) != arity ||
-      std::any_of(tokens.begin(), tokens.end(), [](const std::string& t) { return t.empty(); }))
-    badRequest(name + ": '" + value + "': needs " + std::to_string(arity) + " value" +
-               (arity > 1 ? "s" : "") + (arity > 1 ? " joined by commas" : ""));
-  tokens.insert(tokens.begin(), spec.name);
-  return tokens;
+  // Several are one word, as `sweep --vary` writes them: 320x240 (320,240
+  // and 320:240 read the same; commas were serve's first syntax).
+  std::optional<std::vector<std::string>> tokens = splitOptionValue(value, arity);
+  if (!tokens)
+    badRequest(name + ": '" + value + "': needs " + std::to_string(arity) + " values joined by 'x' (e.g. " +
+               (spec.name == std::string("--size") ? "320x240" : "1x2") + ")");
+  tokens->insert(tokens->begin(), spec.name);
+  return *tokens;
 }
 
 View parseView(const std::string& value) {
@@ -170,7 +135,7 @@ RequestParameters parseRequest(const QueryParameters& query, Endpoint endpoint) 
     previous = name;  // a multimap: equal names are adjacent
     pairGiven |= name == "pair";
     if (takeServerParameter(r, endpoint, name, value, renderer)) continue;
-    const RenderOptionSpec* spec = findOption("--" + name);
+    const RenderOptionSpec* spec = findRenderOption("--" + name);
     if (!spec) badRequest("unknown parameter '" + name + "'");
     if (serverSets(spec->name))
       badRequest(name + ": set by the server" +
@@ -194,8 +159,6 @@ RenderSettings renderSettings(const RequestParameters& request) {
     // The command's message, naming the parameter as the request does.
     const std::string& element = e.element();
     badRequest((element.rfind("--", 0) == 0 ? element.substr(2) : element) + ": " + e.message());
-  } catch (const CLI::ParseError& e) {
-    badRequest(e.what());
   }
 }
 
@@ -229,11 +192,20 @@ std::string commandLine(const RequestParameters& r, Endpoint endpoint) {
   return line;
 }
 
+namespace {
+
+std::string queryDefault(const RenderOptionSpec& spec) {
+  std::string text = defaultText(spec);
+  std::replace(text.begin(), text.end(), ' ', ',');
+  return text;
+}
+
+}  // namespace
+
 nlohmann::ordered_json optionTableJson() {
   nlohmann::ordered_json options = nlohmann::ordered_json::array();
   for (const RenderOptionSpec& spec : renderOptionTable()) {
     if (serverSets(spec.name)) continue;
-    const CLI::Option* option = optionParser().app.get_option(spec.name);
     nlohmann::ordered_json renderers = nlohmann::ordered_json::array();
     for (RendererKind kind : {RendererKind::Raster, RendererKind::Raytrace, RendererKind::Hybrid})
       if (spec.renderers & rendererBit(kind)) renderers.push_back(toString(kind));
@@ -241,12 +213,13 @@ nlohmann::ordered_json optionTableJson() {
                             : spec.condition == OptionCondition::Wireframe ? "wireframe"
                                                                            : "always";
     options.push_back({{"name", std::string(spec.name).substr(2)},
-                       {"values", arityOf(spec)},
+                       {"values", spec.arity},
                        {"renderers", renderers},
                        {"condition", condition},
                        {"applies", describeWhereApplies(spec)},
-                       {"help", option->get_description()},
-                       {"default", option->get_default_str()}});
+                       {"help", helpWithWhere(spec)},
+                       // In the query's own form: multiple values joined by commas, as the page writes them.
+                       {"default", queryDefault(spec)}});
   }
   nlohmann::ordered_json spp = nlohmann::ordered_json::array();
   for (int n = 1; n <= 256; ++n)

@@ -91,7 +91,8 @@ std::shared_ptr<const Scene> SceneCache::loaded(const std::string& path) {
   // Through the render command's own loader and default settings, in the
   // file's frame (a fresh scene's origin is (0, 0, 0): --origin world
   // rebases nothing).
-  const RenderSettings world = renderSettingsFrom({"--origin", "world"});
+  RenderSettings world = renderSettingsFrom({"--origin", "world"});
+  if (loadBudget) world.memory = *loadBudget;
   auto scene = std::make_shared<const Scene>(loadSceneForRender(path, world));
   loaded_.insert(path, scene);
   return scene;
@@ -128,7 +129,7 @@ std::string SceneCache::preparedKey(const std::string& path, const RenderSetting
         "\x1f"
         "camera " +
         std::to_string(*overrides.camera);
-  key += "\x1flights " + settings.lights;
+  key += "\x1flights " + optionText(settings, "--lights");
   return key;
 }
 
@@ -146,6 +147,9 @@ std::shared_ptr<PreparedFrame> SceneCache::frame(const std::string& path,
   frame->raster = settings.raster;
   frame->ray = settings.ray;
   frame->raster.keepSamples = frame->ray.keepSamples = false;
+  // A request's token is set for its render alone (renderPrepared's caller).
+  frame->settings.raster.cancel = frame->raster.cancel = nullptr;
+  frame->settings.ray.cancel = frame->ray.cancel = nullptr;
   frame->memory = estimateRenderMemory(*frame->scene, settings);
   checkMemory(frame->memory, settings.memory, frame->scene->path, "",
               describeRenderWork(settings, toString(settings.renderer)));

@@ -100,6 +100,9 @@ struct SharedCaster {
 
 class SceneCache {
  public:
+  // The limit scene loads are checked against (serve --max-memory);
+  // nullopt: MemoryBudget::machineDefault().
+  std::optional<MemoryBudget> loadBudget;
   // The scene as loaded from `path` (its file frame), parsed once.
   std::shared_ptr<const Scene> loaded(const std::string& path);
   // The scene rebased on the render origin `settings` names, exactly as

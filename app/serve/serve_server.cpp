@@ -118,8 +118,20 @@ struct ExplorerServer::Impl {
   std::mutex renderMutex;
   std::mutex clientsMutex;
   std::map<std::string, uint64_t> latestSeq;  // per client, the newest request seen
+  // Per client, the newest request's render token: a newer request cancels
+  // the one rendering (it stops within about a tile per thread).
+  std::map<std::string, std::shared_ptr<CancelToken>> renderTokens;
 
-  explicit Impl(const ServeOptions& o) : options(o), access(o.scenes, o.root) {}
+  explicit Impl(const ServeOptions& o) : options(o), access(o.scenes, o.root) { cache.loadBudget = o.memory; }
+
+  // The request's settings under the server's --max-memory: a request may
+  // lower the limit, never raise it.
+  RenderSettings settingsOf(const RequestParameters& r) const {
+    RenderSettings s = renderSettings(r);
+    if (options.memory && (!s.isGiven("--max-memory") || s.memory.bytes > options.memory->bytes))
+      s.memory = *options.memory;
+    return s;
+  }
 
   void routes();
   void frame(const httplib::Request& req, httplib::Response& res, bool pngOnly);
@@ -130,12 +142,27 @@ struct ExplorerServer::Impl {
   json imageFrame(const RequestParameters& r, const std::string& path, const RenderSettings& s,
                   std::string& png);
 
-  void noteRequest(const RequestParameters& r) {
-    if (r.client.empty()) return;
+  // Records the request; with a client, returns its render token and
+  // cancels the token of an older request of the same client (nullptr
+  // without a client: nothing can supersede it).
+  std::shared_ptr<CancelToken> noteRequest(const RequestParameters& r) {
+    if (r.client.empty()) return nullptr;
     std::lock_guard<std::mutex> lock(clientsMutex);
-    if (latestSeq.size() > 1024) latestSeq.clear();  // bounded; forgetting only costs a needless render
+    if (latestSeq.size() > 1024) {  // bounded; forgetting only costs a needless render
+      latestSeq.clear();
+      renderTokens.clear();
+    }
     uint64_t& latest = latestSeq[r.client];
+    auto token = std::make_shared<CancelToken>();
+    if (r.seq >= latest) {
+      std::shared_ptr<CancelToken>& current = renderTokens[r.client];
+      if (current && r.seq > latest) current->cancel();
+      current = token;
+    } else {
+      token->cancel();  // already superseded: throwIfSuperseded refuses it
+    }
     latest = std::max(latest, r.seq);
+    return token;
   }
   // Called with the render lock held: a newer request of the same client
   // arrived while this one waited, so its answer would only be thrown away.
@@ -156,6 +183,8 @@ httplib::Server::Handler guarded(std::function<void(const httplib::Request&, htt
       handler(req, res);
     } catch (const HttpError& e) {
       fail(res, e.status(), e.what());
+    } catch (const Cancelled&) {
+      fail(res, 409, "superseded by a newer request while rendering");
     } catch (const InputError& e) {
       fail(res, 400, e.what());
     } catch (const std::bad_alloc&) {
@@ -178,6 +207,14 @@ void refuseParameters(const httplib::Request& req, std::initializer_list<const c
 json ExplorerServer::Impl::imageFrame(const RequestParameters& r, const std::string& path,
                                       const RenderSettings& s, std::string& png) {
   const std::shared_ptr<PreparedFrame> prepared = cache.frame(path, r.renderArgs, s);
+  // This request's token for this render only: the frame is cached.
+  struct TokenScope {
+    PreparedFrame& frame;
+    TokenScope(PreparedFrame& f, const CancelToken* token) : frame(f) {
+      frame.raster.cancel = frame.ray.cancel = token;
+    }
+    ~TokenScope() { frame.raster.cancel = frame.ray.cancel = nullptr; }
+  } scope(*prepared, s.raster.cancel);
   const RenderRun run = renderPrepared(*prepared);
   png = scratch.png([&](const std::string& file) { writePng(file, run.output.image); });
   json work = ordered(renderReportJson(*prepared->scene, s, run));
@@ -230,8 +267,9 @@ json ExplorerServer::Impl::mapFrame(const RequestParameters& r, const std::strin
 void ExplorerServer::Impl::frame(const httplib::Request& req, httplib::Response& res, bool pngOnly) {
   const RequestParameters r = parseRequest(req.params, Endpoint::Frame);
   const std::string path = access.resolve(r.scene);
-  const RenderSettings settings = renderSettings(r);
-  noteRequest(r);
+  RenderSettings settings = settingsOf(r);
+  const std::shared_ptr<CancelToken> token = noteRequest(r);
+  settings.raster.cancel = settings.ray.cancel = token.get();
   std::lock_guard<std::mutex> lock(renderMutex);
   throwIfSuperseded(r);
   std::string png;
@@ -251,13 +289,14 @@ void ExplorerServer::Impl::frame(const httplib::Request& req, httplib::Response&
 void ExplorerServer::Impl::explain(const httplib::Request& req, httplib::Response& res) {
   const RequestParameters r = parseRequest(req.params, Endpoint::Explain);
   const std::string path = access.resolve(r.scene);
-  const RenderSettings settings = renderSettings(r);
+  RenderSettings settings = settingsOf(r);
   const int width = settings.camera.width(), height = settings.camera.height();
   if (r.x >= width || r.y >= height)
     throw HttpError(400, "x, y: pixel (" + std::to_string(r.x) + ", " + std::to_string(r.y) +
                              ") lies outside the " + std::to_string(width) + "x" + std::to_string(height) +
                              " image");
-  noteRequest(r);
+  const std::shared_ptr<CancelToken> token = noteRequest(r);
+  settings.raster.cancel = settings.ray.cancel = token.get();
   std::lock_guard<std::mutex> lock(renderMutex);
   throwIfSuperseded(r);
   const std::shared_ptr<const Scene> scene = cache.prepared(path, settings);
@@ -281,7 +320,7 @@ void ExplorerServer::Impl::sceneInfo(const httplib::Request& req, httplib::Respo
   // The size is checked by the render command's own parser.
   QueryParameters query = {{"scene", r.scene}};
   if (req.has_param("size")) query.emplace("size", req.get_param_value("size"));
-  const RenderSettings settings = renderSettings(parseRequest(query, Endpoint::Frame));
+  const RenderSettings settings = settingsOf(parseRequest(query, Endpoint::Frame));
   const std::string path = access.resolve(r.scene);
   std::lock_guard<std::mutex> lock(renderMutex);
   json j = sceneInfoJson(*cache.loaded(path), settings.camera.width(), settings.camera.height());

@@ -19,8 +19,11 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "common/memory_budget.h"
 
 namespace rastray::serve {
 
@@ -29,6 +32,10 @@ struct ServeOptions {
   std::string root;                 // directory whose glTF files may be opened; empty: none
   std::string host = "127.0.0.1";
   int port = 8080;  // 0: any free port
+  // serve --max-memory: the limit of every scene load and render; a
+  // request's own max-memory may only lower it. nullopt: the machine
+  // default, as for the other commands.
+  std::optional<MemoryBudget> memory;
 };
 
 class ExplorerServer {

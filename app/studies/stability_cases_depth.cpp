@@ -140,9 +140,8 @@ Expect expectedFighting(DepthFormat format, double ratio) {
   for (int k = 0; k < kColumns; ++k) {
     const double d = dMin * std::pow(dMax / dMin, double(k) / double(kColumns - 1));
     for (const double depth : {d * 0.76, d * 1.24})
-      worst = std::max(worst,
-                       viewDepthResolution(encodingOf(format), Projection::Perspective, znear, kZfar, depth) /
-                           (kGap * depth));
+      worst = std::max(
+          worst, viewDepthResolution(format, Projection::Perspective, znear, kZfar, depth) / (kGap * depth));
   }
   return worst > 2.0 ? Expect::Fights : worst < 0.5 ? Expect::Clean : Expect::Either;
 }

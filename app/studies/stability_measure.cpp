@@ -5,8 +5,6 @@
 #include <cstdio>
 #include <filesystem>
 
-#include <CLI/CLI.hpp>
-
 #include "common/error.h"
 #include "common/math_constants.h"
 #include "common/sampling.h"
@@ -64,16 +62,12 @@ uint64_t countNanInf(const RenderOutput& output) {
 VisibilityReport visibilityAgainst(const Rendered& a, const Rendered& reference) {
   if (!a.run.output.hasSamples || !reference.run.output.hasSamples)
     throw std::logic_error("visibilityAgainst: both renders need their samples (renderVariant deep = true)");
-  ClassifierSettings classifier;
   const auto rasterizes = [](const Rendered& r) { return r.settings.renderer != RendererKind::Raytrace; };
-  if (rasterizes(a))
-    classifier.depthFormat = storedDepthFormat(a.settings.raster.depthFormat);
-  else if (rasterizes(reference))
-    classifier.depthFormat = storedDepthFormat(reference.settings.raster.depthFormat);
+  const DepthFormat format = rasterizes(a)           ? a.settings.raster.depthFormat
+                             : rasterizes(reference) ? reference.settings.raster.depthFormat
+                                                     : DepthFormat::FloatReversed;
   const Camera& camera = reference.camera();
-  classifier.planes = {true, camera.projection, camera.znear, camera.zfar};
-  classifier.scene = &reference.scene;
-  classifier.camera = &camera;
+  const ClassifierSettings classifier = classifierSettings(reference.scene, camera, format);
   return compareVisibility(a.run.output.samples, reference.run.output.samples, reference.settings.spp,
                            classifier, FrameNames{toString(a.settings.renderer), "reference"});
 }

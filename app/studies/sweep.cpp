@@ -7,6 +7,7 @@
 #include <memory>
 #include <set>
 
+#include <OpenImageIO/imageio.h>
 #include <tbb/global_control.h>
 
 #include "app/crossval/crossval.h"
@@ -42,8 +43,7 @@ std::vector<std::string> split(const std::string& text, const std::string& separ
 
 // What the render command knows about each of its options: how many values
 // it takes (0: a flag) and its row of the render-option table (nullptr for
-// --renderer). Read from a parser built by addRenderSettings itself, so the
-// sweep accepts exactly what `rastray render` accepts.
+// --renderer), so the sweep accepts exactly what `rastray render` accepts.
 struct OptionInfo {
   int arity = 1;
   const RenderOptionSpec* spec = nullptr;
@@ -51,15 +51,9 @@ struct OptionInfo {
 
 const std::map<std::string, OptionInfo>& optionInfo() {
   static const std::map<std::string, OptionInfo> info = [] {
-    CLI::App app;
-    RenderSettings settings;
-    addRenderSettings(app, settings, /*withRenderer=*/true);
     std::map<std::string, OptionInfo> m;
     m["--renderer"] = {1, nullptr};
-    for (const RenderOptionSpec& spec : renderOptionTable()) {
-      const CLI::Option* option = app.get_option(spec.name);
-      m[spec.name] = {option->get_items_expected_max(), &spec};
-    }
+    for (const RenderOptionSpec& spec : renderOptionTable()) m[spec.name] = {spec.arity, &spec};
     return m;
   }();
   return info;
@@ -100,9 +94,9 @@ OptionGroup varyGroup(const VaryAxis& axis, int index, const std::string& value)
       bad("--vary " + axis.name, "'" + value + "': a flag takes on or off");
     return g;
   }
-  g.values = arity == 1 ? std::vector<std::string>{value} : split(value, "x:");
-  if (int(g.values.size()) != arity ||
-      std::any_of(g.values.begin(), g.values.end(), [](const std::string& v) { return v.empty(); }))
+  const std::optional<std::vector<std::string>> values = splitOptionValue(value, arity);
+  if (values) g.values = *values;
+  if (!values)
     bad("--vary " + axis.name, "'" + value + "': needs " + std::to_string(arity) +
                                    " numbers joined by 'x' or ':' (e.g. " +
                                    (axis.name == "size" ? "160x120" : "1:2:3") + ")");
@@ -440,6 +434,21 @@ double stageSeconds(const RenderRun& run, const std::string& stage) {
 
 }  // namespace
 
+namespace {
+
+// Whether the file's R channel is stored as half: rounded colours no
+// render's float colours equal.
+bool halfColor(const std::string& path) {
+  const auto in = OIIO::ImageInput::open(path);
+  if (!in) return false;
+  const OIIO::ImageSpec& spec = in->spec();
+  for (int c = 0; c < spec.nchannels; ++c)
+    if (spec.channelnames[size_t(c)] == "R") return spec.channelformat(c) == OIIO::TypeDesc::HALF;
+  return false;
+}
+
+}  // namespace
+
 const Reference& ReferenceSource::referenceFor(const Cell& cell) {
   const bool automatic = reference_ == "auto";
   const std::string key = automatic ? cell.scene + '\n' + join(cell.referenceArgs, " ") : reference_;
@@ -458,6 +467,12 @@ const Reference& ReferenceSource::referenceFor(const Cell& cell) {
     if (!r.color.hasColor) throw InputError(reference_, "", "a reference needs colour (R G B)");
     r.centre = r.color;
     r.description = reference_ + " (Z and IDs: the file's sample nearest each pixel centre)";
+    if (halfColor(reference_))
+      r.inexact =
+          "its colour is half-float, so no cell scores 0 against it, not even at its own settings: render "
+          "the "
+          "reference with --float (and --spp 1, so its Z and IDs are the pixel centres the cells are "
+          "compared at)";
   }
   return cache_.emplace(key, std::move(r)).first->second;
 }
@@ -507,12 +522,10 @@ CellResult measureCell(const Cell& cell, int repeat, ReferenceSource& references
   // Differences at the centres are classified in the cell's frame, against
   // the depth buffer it rasterized with (the ray caster: float-reversed).
   const Camera camera = makeCamera(scene, cell.settings.camera.overrides(), width, height);
-  ClassifierSettings classifier;
-  if (cell.settings.renderer != RendererKind::Raytrace)
-    classifier.depthFormat = storedDepthFormat(cell.settings.raster.depthFormat);
-  classifier.planes = {true, camera.projection, camera.znear, camera.zfar};
-  classifier.scene = &scene;
-  classifier.camera = &camera;
+  const ClassifierSettings classifier =
+      classifierSettings(scene, camera,
+                         cell.settings.renderer != RendererKind::Raytrace ? cell.settings.raster.depthFormat
+                                                                          : DepthFormat::FloatReversed);
   result.errors = measureErrors(image, centre, reference, &classifier);
   return result;
 }

@@ -122,6 +122,9 @@ struct Reference {
   FlatImage color;
   FlatImage centre;
   std::string description;  // how it was made
+  // Empty, or why no cell can equal the file, with the settings it needs (a
+  // half-float colour: render it with --float, at --spp 1).
+  std::string inexact;
 };
 
 // color: the cell's resolved image; centre: the cell's Z and IDs at the

@@ -94,7 +94,7 @@ TEST(Crossover, TheSurfaceFillsTheViewWithItsTriangles) {
       crossoverScene(t, false, double(size.width) / double(size.height)).writeGlb(path);
       for (const char* renderer : {"raster", "raytrace"}) {
         RenderSettings settings;
-        settings.rendererName = renderer;
+        settings.renderer = *parseRendererKind(renderer);
         settings.camera.size = {size.width, size.height};
         settings.finish();
         const Scene scene = loadSceneForRender(path, settings);

@@ -7,11 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "app/engine/render_setup.h"
 #include "common/error.h"
@@ -116,24 +117,15 @@ Args operator+(Args a, const Args& b) {
   return a;
 }
 
-// Parses `args` as `render` (withRenderer) or crossval/explain would and
-// runs finish(): the InputError it threw, if any.
+// Parses `args` as `render` (withRenderer) or crossval/explain would
+// (renderSettingsFrom, which runs finish()): the InputError it threw, if any.
 std::optional<InputError> finishWith(const Args& args, bool withRenderer = true,
                                      RenderSettings* out = nullptr) {
-  CLI::App app;
-  RenderSettings settings;
-  addRenderSettings(app, settings, withRenderer);
-  Args reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
-  app.parse(reversed);
   try {
-    settings.finish();
+    RenderSettings settings = renderSettingsFrom(args, /*allRenderers=*/!withRenderer);
+    if (out) *out = settings;
   } catch (const InputError& e) {
     return e;
-  }
-  if (out) {
-    settings.camera.detach();  // its option pointers point into `app` too
-    *out = settings;
-    out->cliOptions.clear();  // they point into `app`
   }
   return std::nullopt;
 }
@@ -159,19 +151,15 @@ TEST(RenderOptionTable, SaysWhereEachOptionApplies) {
   }
 }
 
+// The CLI registers one option per row (cli/render_options_cli.cpp), and
+// --help says where each applies.
 TEST(RenderOptionTable, DrivesTheRegistration) {
-  CLI::App app;
-  RenderSettings settings;
-  addRenderSettings(app, settings);
-  ASSERT_EQ(settings.cliOptions.size(), renderOptionTable().size());
-  for (size_t i = 0; i < settings.cliOptions.size(); ++i) {
-    ASSERT_NE(settings.cliOptions[i], nullptr) << renderOptionTable()[i].name;
-    EXPECT_TRUE(settings.cliOptions[i]->check_name(renderOptionTable()[i].name));
-  }
-  // --help says where an option applies.
-  const std::string help = app.help();
-  EXPECT_NE(help.find("[raster and hybrid with --shadows map]"), std::string::npos) << help;
-  EXPECT_NE(help.find("[raytrace]"), std::string::npos) << help;
+  const auto r = runRastray({"render", "--help"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const RenderOptionSpec& spec : renderOptionTable())
+    EXPECT_NE(r.out.find(std::string(spec.name) + " "), std::string::npos) << spec.name << "\n" << r.out;
+  EXPECT_NE(r.out.find("[raster and hybrid with --shadows map]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("[raytrace]"), std::string::npos) << r.out;
 }
 
 TEST(RenderOptions, RefusedForRenderersTheyDoNotApplyTo) {
@@ -322,6 +310,94 @@ TEST(RenderOptionsCommand, AcceptedWhereTheyApply) {
   const auto e = runRastray({"explain", kScene, "1", "1", "--size", "16", "12", "--halo"});
   EXPECT_EQ(e.status, 2) << e.err;
   EXPECT_EQ(e.err.rfind("command line: --halo: ", 0), 0u) << e.err;
+}
+
+// toArgs writes back what renderSettingsFrom read: every row's formatter
+// is its parser's inverse (the same values, bit for bit, floats included).
+TEST(RenderOptions, ToArgsGivesTheSameSettingsBack) {
+  const Args args = {"--renderer",
+                     "hybrid",
+                     "--size",
+                     "33",
+                     "17",
+                     "--spp",
+                     "4",
+                     "--eye",
+                     "0.1",
+                     "-2.5e-7",
+                     "3",
+                     "--yfov",
+                     "41.3",
+                     "--zfar",
+                     "inf",
+                     "--lights",
+                     "2,0",
+                     "--polygon-offset",
+                     "0.3",
+                     "-1",
+                     "--shadows",
+                     "map",
+                     "--shadow-bias",
+                     "0.001",
+                     "2",
+                     "--transparency",
+                     "peel:3",
+                     "--transparency-cutoff",
+                     "0.0001",
+                     "--max-memory",
+                     "3G",
+                     "--cull",
+                     "front",
+                     "--halo",
+                     "--wireframe"};
+  const RenderSettings a = renderSettingsFrom(args);
+  const Args written = toArgs(a);
+  const RenderSettings b = renderSettingsFrom(written);
+  EXPECT_EQ(toArgs(b), written);
+  EXPECT_EQ(b.camera.eye, a.camera.eye);
+  EXPECT_EQ(b.camera.yfov, a.camera.yfov);
+  EXPECT_EQ(b.raster.polygonOffsetFactor, a.raster.polygonOffsetFactor);
+  EXPECT_EQ(b.raster.shadowBiasConstant, a.raster.shadowBiasConstant);
+  EXPECT_EQ(b.ray.transparencyCutoff, a.ray.transparencyCutoff);
+  EXPECT_EQ(b.raster.peelLayers, 3);
+  EXPECT_EQ(b.memory.bytes, 3ull << 30);
+  EXPECT_EQ(*b.keptLights, (std::vector<size_t>{0, 2}));
+  EXPECT_EQ(
+      joined(toArgs(a, {"--max-memory"})),
+      " --renderer hybrid --eye 0.1 -2.5e-07 3 --yfov 41.3 --zfar inf --size 33 17 --spp 4 --lights 0,2 "
+      "--cull front --shadows map --polygon-offset 0.3 -1 --transparency peel:3 --wireframe --halo "
+      "--shadow-bias 0.001 2 --transparency-cutoff 0.0001");
+  // Given twice, or not a render option: refused, naming it.
+  auto error = finishWith({"--spp", "4", "--spp", "8"});
+  ASSERT_TRUE(error);
+  EXPECT_EQ(std::string(error->what()), "command line: --spp: given more than once");
+  error = finishWith({"--spp", "four"});
+  ASSERT_TRUE(error);
+  EXPECT_EQ(std::string(error->what()), "command line: --spp: 'four' is not an integer");
+}
+
+// docs/OPTIONS.md holds the table as renderOptionsMarkdown() writes it,
+// between two marker lines; RASTRAY_UPDATE_DOCS=1 rewrites it.
+TEST(RenderOptionTable, DocsOptionsPageHoldsTheTable) {
+  const std::string path = std::string(RASTRAY_SCENES) + "/../docs/OPTIONS.md";
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path;
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  std::string text = buffer.str();
+  const std::string begin = "<!-- options table: begin -->\n", end = "<!-- options table: end -->";
+  const size_t from = text.find(begin), to = text.find(end);
+  ASSERT_NE(from, std::string::npos) << path;
+  ASSERT_NE(to, std::string::npos) << path;
+  const std::string table = renderOptionsMarkdown();
+  if (std::getenv("RASTRAY_UPDATE_DOCS")) {
+    text.replace(from + begin.size(), to - from - begin.size(), table);
+    std::ofstream(path) << text;
+    return;
+  }
+  EXPECT_EQ(text.substr(from + begin.size(), to - from - begin.size()), table)
+      << "docs/OPTIONS.md is stale: run RASTRAY_UPDATE_DOCS=1 ./build/tests/app_tests "
+         "--gtest_filter='RenderOptionTable.DocsOptionsPageHoldsTheTable'";
 }
 
 }  // namespace

@@ -60,8 +60,8 @@ GltfScene litScene(const glm::dvec3& offset) {
 
 RenderSettings settingsFor(RendererKind renderer, RenderOrigin origin) {
   RenderSettings s;
-  s.rendererName = toString(renderer);
-  s.origin = toString(origin);
+  s.renderer = renderer;
+  s.renderOrigin = origin;
   s.camera.size = {480, 320};
   s.finish();
   return s;

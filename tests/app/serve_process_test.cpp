@@ -176,6 +176,15 @@ TEST(ServeProcess, StopsCleanlyOnSigintAndSigterm) {
   }
 }
 
+// serve honours --max-memory as the other commands do (it was refused).
+TEST(ServeProcess, AcceptsMaxMemory) {
+  const fs::path dir = freshDir("serve-max-memory");
+  ServeProcess server({scenePath("three-triangles"), "--max-memory", "1G"}, dir);
+  ASSERT_GT(server.port(), 0) << server.err();
+  EXPECT_EQ(server.stop(SIGTERM), 128 + SIGTERM) << server.err();
+  fs::remove_all(dir);
+}
+
 TEST(ServeProcess, BadCommandLineExitsWithStatus2) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"serve"}, "name at least one scene, or a --root directory"},
@@ -183,6 +192,7 @@ TEST(ServeProcess, BadCommandLineExitsWithStatus2) {
       {{"serve", "--root", "no-such-directory"}, "--root: 'no-such-directory' is not a directory"},
       {{"serve", scenePath("three-triangles"), "--port", "70000"}, "--port"},
       {{"serve", scenePath("three-triangles"), "--host", "192.0.2.1", "--port", "1"}, "cannot listen on"},
+      {{"serve", scenePath("three-triangles"), "--max-memory", "1Q"}, "command line: --max-memory: "},
   };
   for (const auto& [args, message] : cases) {
     const auto r = test::runRastray(args);

@@ -4,8 +4,10 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -282,11 +284,11 @@ TEST_F(ServeTest, ExplainReturnsTheExplanationAndTheRayTreeOnTheImage) {
 TEST_F(ServeTest, BadParametersGet400WithTheCommandsMessage) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"/api/image?" + cornell() + "&spp=9", "spp: 9 is not supported"},
-      {"/api/image?" + cornell() + "&spp=abc", "--spp"},
-      {"/api/image?" + cornell() + "&size=0,10", "--size"},
-      {"/api/image?" + cornell() + "&size=20000,10", "--size"},
+      {"/api/image?" + cornell() + "&spp=abc", "spp: 'abc' is not an integer"},
+      {"/api/image?" + cornell() + "&size=0,10", "size: '0' is not in [1, 16384]"},
+      {"/api/image?" + cornell() + "&size=20000,10", "size: '20000' is not in [1, 16384]"},
       {"/api/image?" + cornell() + "&size=10", "size: '10': needs 2 values"},
-      {"/api/image?" + cornell() + "&max-depth=65&renderer=raytrace", "--max-depth"},
+      {"/api/image?" + cornell() + "&max-depth=65&renderer=raytrace", "max-depth: '65' is not in [0, 64]"},
       {"/api/image?" + cornell() + "&renderer=vulkan", "renderer: 'vulkan' is not one of"},
       {"/api/image?" + cornell() + "&renderer=raytrace&shadow-map-size=512",
        "shadow-map-size: applies to raster"},
@@ -310,6 +312,45 @@ TEST_F(ServeTest, BadParametersGet400WithTheCommandsMessage) {
     EXPECT_EQ(r->status, 400) << target;
     EXPECT_NE(r->body.find(message), std::string::npos) << target << " -> " << r->body;
   }
+}
+
+// serve --max-memory limits every render; a request may lower the limit,
+// not raise it.
+TEST(ServeMemory, TheServersLimitHoldsForEveryRequest) {
+  serve::ServeOptions options;
+  options.scenes = {scenePath("cornell-box")};
+  options.port = 0;
+  options.memory = MemoryBudget::parse("100K");
+  serve::ExplorerServer server(options);
+  const int port = server.bind();
+  std::thread thread([&] { server.run(); });
+  httplib::Client client("127.0.0.1", port);
+  client.set_read_timeout(120, 0);
+  const std::string scene = "scene=" + httplib::detail::encode_query_param(scenePath("cornell-box"));
+  for (const std::string& extra : {std::string(""), std::string("&max-memory=8G")}) {
+    const auto r = client.Get(("/api/image?" + scene + "&size=16x12" + extra).c_str());
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 400) << extra;
+    EXPECT_NE(r->body.find("above the memory limit of 100.0 KiB"), std::string::npos) << r->body;
+  }
+  server.stop();
+  thread.join();
+}
+
+// One size syntax everywhere: 320x240 as `sweep --vary` writes it; the
+// first form, 320,240, reads the same.
+TEST_F(ServeTest, SizesReadWidthXHeight) {
+  for (const char* size : {"40x30", "40,30"}) {
+    const auto r = get("/api/frame?" + cornell() + "&size=" + size);
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << size << ": " << r->body;
+    EXPECT_EQ(json::parse(r->body)["size"], json::array({40, 30})) << size;
+  }
+  const auto bad = get("/api/frame?" + cornell() + "&size=40x");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("size: '40x': needs 2 values joined by 'x' (e.g. 320x240)"), std::string::npos)
+      << bad->body;
 }
 
 TEST_F(ServeTest, UnknownParameterGets400) {
@@ -390,6 +431,28 @@ TEST_F(ServeTest, RequestsForAnotherHostNameAreRefused) {
   // A page elsewhere whose DNS name is rebound to 127.0.0.1 is refused.
   EXPECT_EQ(get("/api/scenes", "attacker.example:80")->status, 403);
   EXPECT_EQ(get("/api/scenes", "localhost:" + std::to_string(port_))->status, 200);
+}
+
+// A request superseded while it renders stops rendering (at its next
+// tile) and answers 409: the first render here would take minutes on two
+// cores (2048x2048 at 64 spp, ray cast), so a 409 after the newer request
+// arrived can only come from the cancelled render; without cancellation it
+// would run to the end and answer 200.
+TEST_F(ServeTest, RequestSupersededWhileRenderingStops) {
+  const std::string slow =
+      "/api/image?" + cornell() + "&renderer=raytrace&size=2048x2048&spp=64&client=page9&seq=1";
+  std::optional<httplib::Result> first;
+  std::thread thread([&] { first = get(slow); });
+  // Long enough for the first request to be rendering (its scene loads in
+  // milliseconds); the newer one then waits for the render lock.
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  const auto second = get("/api/image?" + cornell() + "&size=16x12&client=page9&seq=2");
+  thread.join();
+  ASSERT_TRUE(first && *first);
+  EXPECT_EQ((*first)->status, 409) << (*first)->body;
+  EXPECT_EQ((*first)->body, "superseded by a newer request while rendering\n");
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->status, 200) << second->body;
 }
 
 TEST_F(ServeTest, OlderRequestOfTheSameClientIsSuperseded) {

@@ -269,6 +269,21 @@ TEST(SweepReference, AFlatExrWorksAndItsOwnSettingsHaveNoError) {
   EXPECT_EQ(rows[0].errors.visibility, 0.0);
   EXPECT_EQ(rows[0].errors.depthMaxAbs, 0.0);
   EXPECT_GT(rows[1].errors.rms, 0.0);  // 4 spp resolves edges differently
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  // A half-float reference cannot score 0 at its own settings: the sweep
+  // says so, and which file settings would.
+  const test::CommandResult half = test::runRastray(
+      {"render", scene, "--renderer", "raytrace", "--size", "12", "8", "-o", dir / "half.exr"});
+  ASSERT_EQ(half.status, 0) << half.err;
+  const test::CommandResult warned =
+      test::runRastray({"sweep", scene, "--renderer", "raytrace", "--vary", "spp=1", "--size", "12", "8",
+                        "--repeat", "1", "--reference", dir / "half.exr", "--report", dir / "h"});
+  ASSERT_EQ(warned.status, 0) << warned.err;
+  EXPECT_NE(warned.err.find("rastray sweep: warning: " + (dir / "half.exr") +
+                            ": its colour is half-float, so no cell scores 0 against it"),
+            std::string::npos)
+      << warned.err;
+  EXPECT_NE(warned.err.find("--float (and --spp 1"), std::string::npos) << warned.err;
   // A reference of another size is refused before anything runs.
   const test::CommandResult wrong =
       test::runRastray({"sweep", scene, "--renderer", "raytrace", "--vary", "spp=1,4", "--size", "16", "8",

@@ -12,8 +12,8 @@ namespace rastray {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr DepthEncoding kEncodings[] = {DepthEncoding::FloatReversed, DepthEncoding::Float,
-                                        DepthEncoding::Unorm24, DepthEncoding::Unorm16};
+constexpr DepthFormat kEncodings[] = {DepthFormat::FloatReversed, DepthFormat::Float, DepthFormat::Unorm24,
+                                      DepthFormat::Unorm16};
 
 double relativeError(double value, long double exact) {
   return double(std::fabs((long double)value - exact) / std::fabs(exact));
@@ -66,8 +66,8 @@ TEST(DepthFormula, ReversedIsOneMinusConventional) {
       for (double d : {0.1, 0.5, 3.0, 50.0, 99.0}) {
         const double z = conventionalWindowDepth(p, 0.1, f, d), s = reversedWindowDepth(p, 0.1, f, d);
         EXPECT_NEAR(z + s, 1.0, 1e-15) << d;
-        EXPECT_EQ(storedWindowDepth(DepthEncoding::FloatReversed, p, 0.1, f, d), s);
-        EXPECT_EQ(storedWindowDepth(DepthEncoding::Unorm24, p, 0.1, f, d), z);
+        EXPECT_EQ(storedWindowDepth(DepthFormat::FloatReversed, p, 0.1, f, d), s);
+        EXPECT_EQ(storedWindowDepth(DepthFormat::Unorm24, p, 0.1, f, d), z);
       }
     }
   EXPECT_EQ(conventionalWindowDepth(Projection::Perspective, 0.1, kInf, 0.1), 0.0);
@@ -89,25 +89,24 @@ TEST(DepthFormula, SlopeIsTheDerivative) {
 }
 
 TEST(DepthFormula, Steps) {
-  EXPECT_EQ(depthStep(DepthEncoding::Unorm24, 0.5), 0x1p-24);
-  EXPECT_EQ(depthStep(DepthEncoding::Unorm16, 0.5), 0x1p-16);
-  EXPECT_EQ(depthStep(DepthEncoding::Float, 0.75), 0x1p-24);
-  EXPECT_EQ(depthStep(DepthEncoding::FloatReversed, 0.001), 0x1p-33);
+  EXPECT_EQ(depthStep(DepthFormat::Unorm24, 0.5), 0x1p-24);
+  EXPECT_EQ(depthStep(DepthFormat::Unorm16, 0.5), 0x1p-16);
+  EXPECT_EQ(depthStep(DepthFormat::Float, 0.75), 0x1p-24);
+  EXPECT_EQ(depthStep(DepthFormat::FloatReversed, 0.001), 0x1p-33);
   EXPECT_EQ(float32Ulp(0.0), 0x1p-149);
   EXPECT_EQ(float32Ulp(1.0), 0x1p-23);
   EXPECT_EQ(float32Ulp(-3.0), 0x1p-22);
   EXPECT_TRUE(std::isinf(float32Ulp(kInf)));
-  EXPECT_TRUE(std::isinf(viewDepthResolution(DepthEncoding::Float, Projection::Perspective, 0.1, kInf, 0.0)));
-  EXPECT_TRUE(
-      std::isinf(viewDepthResolution(DepthEncoding::Float, Projection::Perspective, 0.1, kInf, kInf)));
+  EXPECT_TRUE(std::isinf(viewDepthResolution(DepthFormat::Float, Projection::Perspective, 0.1, kInf, 0.0)));
+  EXPECT_TRUE(std::isinf(viewDepthResolution(DepthFormat::Float, Projection::Perspective, 0.1, kInf, kInf)));
 }
 
 // The value a buffer of the encoding holds for stored value s.
-double rounded(DepthEncoding e, double s) {
+double rounded(DepthFormat e, double s) {
   switch (e) {
-    case DepthEncoding::Unorm24:
+    case DepthFormat::Unorm24:
       return double(std::lround(s * double((1u << 24) - 1u)));
-    case DepthEncoding::Unorm16:
+    case DepthFormat::Unorm16:
       return double(std::lround(s * double((1u << 16) - 1u)));
     default:
       return double(float(s));
@@ -117,7 +116,7 @@ double rounded(DepthEncoding e, double s) {
 TEST(DepthFormula, ResolutionIsWhatTheRoundedValuesTellApart) {
   // Moving a view depth by twice the stated resolution changes the value
   // the buffer holds; the resolution is honest for every encoding.
-  for (DepthEncoding e : kEncodings)
+  for (DepthFormat e : kEncodings)
     for (Projection p : {Projection::Perspective, Projection::Orthographic})
       for (double f : {1000.0, kInf}) {
         if (p == Projection::Orthographic && std::isinf(f)) continue;

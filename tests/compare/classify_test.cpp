@@ -19,37 +19,34 @@ HitRecord hit(uint32_t instance, uint32_t triangle, float depth) { return {insta
 TEST(DepthResolution, FloatReversedPerspectiveInfiniteFar) {
   // s = n/d = 0.01 lies in [2^-7, 2^-6): ulp 2^-30; |dz/dd| = n/d² = 0.001.
   const DepthPlanes planes{true, Projection::Perspective, 0.1, std::numeric_limits<double>::infinity()};
-  EXPECT_DOUBLE_EQ(depthResolution(StoredDepthFormat::FloatReversed, planes, 10.0),
-                   std::ldexp(1.0, -30) / 0.001);
+  EXPECT_DOUBLE_EQ(depthResolution(DepthFormat::FloatReversed, planes, 10.0), std::ldexp(1.0, -30) / 0.001);
   // The plane-free bound d·2^-23 holds.
-  EXPECT_LE(depthResolution(StoredDepthFormat::FloatReversed, planes, 10.0), 10.0 * std::ldexp(1.0, -23));
+  EXPECT_LE(depthResolution(DepthFormat::FloatReversed, planes, 10.0), 10.0 * std::ldexp(1.0, -23));
 }
 
 TEST(DepthResolution, ConventionalFormatsPerspective) {
   const DepthPlanes planes{true, Projection::Perspective, 0.1, std::numeric_limits<double>::infinity()};
   // z = 1 − n/d = 0.99: unorm24 step 2^-24, float ulp(0.99) = 2^-24; slope 0.001.
-  EXPECT_DOUBLE_EQ(depthResolution(StoredDepthFormat::Unorm24, planes, 10.0), std::ldexp(1.0, -24) / 0.001);
-  EXPECT_DOUBLE_EQ(depthResolution(StoredDepthFormat::Float, planes, 10.0), std::ldexp(1.0, -24) / 0.001);
-  EXPECT_DOUBLE_EQ(depthResolution(StoredDepthFormat::Unorm16, planes, 10.0), std::ldexp(1.0, -16) / 0.001);
+  EXPECT_DOUBLE_EQ(depthResolution(DepthFormat::Unorm24, planes, 10.0), std::ldexp(1.0, -24) / 0.001);
+  EXPECT_DOUBLE_EQ(depthResolution(DepthFormat::Float, planes, 10.0), std::ldexp(1.0, -24) / 0.001);
+  EXPECT_DOUBLE_EQ(depthResolution(DepthFormat::Unorm16, planes, 10.0), std::ldexp(1.0, -16) / 0.001);
   // Finite far: slope n f / ((f − n) d²) = 0.1·100 / (99.9·100).
   const DepthPlanes finite{true, Projection::Perspective, 0.1, 100.0};
-  EXPECT_DOUBLE_EQ(depthResolution(StoredDepthFormat::Unorm24, finite, 10.0),
+  EXPECT_DOUBLE_EQ(depthResolution(DepthFormat::Unorm24, finite, 10.0),
                    std::ldexp(1.0, -24) / (0.1 * 100.0 / (99.9 * 100.0)));
 }
 
 TEST(DepthResolution, OrthographicIsLinear) {
   const DepthPlanes planes{true, Projection::Orthographic, 0.125, 1.0};
-  EXPECT_DOUBLE_EQ(depthResolution(StoredDepthFormat::Unorm16, planes, 0.5), std::ldexp(1.0, -16) * 0.875);
+  EXPECT_DOUBLE_EQ(depthResolution(DepthFormat::Unorm16, planes, 0.5), std::ldexp(1.0, -16) * 0.875);
   // Reversed s = (f − d)/(f − n) = 0.5/0.875 ≈ 0.571: ulp 2^-24.
-  EXPECT_DOUBLE_EQ(depthResolution(StoredDepthFormat::FloatReversed, planes, 0.5),
-                   std::ldexp(1.0, -24) * 0.875);
+  EXPECT_DOUBLE_EQ(depthResolution(DepthFormat::FloatReversed, planes, 0.5), std::ldexp(1.0, -24) * 0.875);
 }
 
 TEST(DepthResolution, WithoutPlanesOnlyFloatReversedHasABound) {
   const DepthPlanes unknown;
-  EXPECT_DOUBLE_EQ(depthResolution(StoredDepthFormat::FloatReversed, unknown, 3.0),
-                   3.0 * std::ldexp(1.0, -23));
-  EXPECT_TRUE(std::isinf(depthResolution(StoredDepthFormat::Unorm24, unknown, 3.0)));
+  EXPECT_DOUBLE_EQ(depthResolution(DepthFormat::FloatReversed, unknown, 3.0), 3.0 * std::ldexp(1.0, -23));
+  EXPECT_TRUE(std::isinf(depthResolution(DepthFormat::Unorm24, unknown, 3.0)));
 }
 
 TEST(DepthResolution, Ulp32) {
@@ -139,7 +136,7 @@ TEST(Classifier, FloatIntersectionErrorGrowsAtGrazingAndForSlivers) {
   Scene s;
   s.path = "bound";
   s.positions = {{-1.0f, -1.0f, -2.0f}, {1.0f, -1.0f, -2.0f}, {0.0f, 1.0f, -2.0f},
-                 {-1.0f, 0.0f, -2.0f}, {1.0f, 0.0f, -2.0f}, {1.0f, 1e-4f, -2.0f}};
+                 {-1.0f, 0.0f, -2.0f},  {1.0f, 0.0f, -2.0f},  {1.0f, 1e-4f, -2.0f}};
   s.triangles = {{0, 1, 2}, {3, 4, 5}};
   Instance inst;
   inst.vertexCount = 6;
@@ -156,7 +153,7 @@ TEST(Classifier, FloatIntersectionErrorGrowsAtGrazingAndForSlivers) {
   EXPECT_NEAR(floatIntersectionError(s, 0, 0, ray, 2.0) / headOn, 100.0, 1.0);
   ray.direction = {0.0, 0.0, -1.0};
   EXPECT_GT(floatIntersectionError(s, 0, 1, ray, 2.0), 1000.0 * headOn);  // aspect 2e4 sliver
-  ray.direction = {1.0, 0.0, 0.0};  // parallel to the plane
+  ray.direction = {1.0, 0.0, 0.0};                                        // parallel to the plane
   EXPECT_TRUE(std::isinf(floatIntersectionError(s, 0, 0, ray, 2.0)));
 }
 
@@ -170,7 +167,7 @@ TEST(Classifier, DepthTieFollowsTheFormat) {
   EXPECT_EQ(fr.classify({0, 0}, hit(0, 0, d), hit(1, 0, oneUlp), {}), MismatchClass::DepthTie);
   EXPECT_EQ(fr.classify({0, 0}, hit(0, 0, d), hit(1, 0, d + 1e-5f), {}), MismatchClass::Genuine);
   // unorm16: 2^-16·0.875 ≈ 1.3e-5: the same 1e-5 difference is a tie.
-  settings.depthFormat = StoredDepthFormat::Unorm16;
+  settings.depthFormat = DepthFormat::Unorm16;
   MismatchClassifier u16(settings);
   EXPECT_EQ(u16.classify({0, 0}, hit(0, 0, d), hit(1, 0, d + 1e-5f), {}), MismatchClass::DepthTie);
   EXPECT_EQ(u16.classify({0, 0}, hit(0, 0, d), hit(1, 0, d + 2e-5f), {}), MismatchClass::Genuine);
@@ -203,10 +200,9 @@ TEST(Classifier, ImageSpaceFallback) {
 }
 
 TEST(Classifier, NamesRoundTrip) {
-  for (auto f : {StoredDepthFormat::FloatReversed, StoredDepthFormat::Float, StoredDepthFormat::Unorm24,
-                 StoredDepthFormat::Unorm16})
-    EXPECT_EQ(parseStoredDepthFormat(toString(f)), f);
-  EXPECT_FALSE(parseStoredDepthFormat("float32"));
+  for (auto f : {DepthFormat::FloatReversed, DepthFormat::Float, DepthFormat::Unorm24, DepthFormat::Unorm16})
+    EXPECT_EQ(parseDepthFormat(toString(f)), f);
+  EXPECT_FALSE(parseDepthFormat("float32"));
   EXPECT_STREQ(toString(MismatchClass::SharedEdgeTie), "shared-edge-tie");
 }
 

@@ -14,11 +14,11 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 TEST(DepthFormulaAgreement, ResolutionAndTiesUseTheSharedDefinition) {
-  const std::pair<StoredDepthFormat, DepthEncoding> formats[] = {
-      {StoredDepthFormat::FloatReversed, DepthEncoding::FloatReversed},
-      {StoredDepthFormat::Float, DepthEncoding::Float},
-      {StoredDepthFormat::Unorm24, DepthEncoding::Unorm24},
-      {StoredDepthFormat::Unorm16, DepthEncoding::Unorm16}};
+  const std::pair<DepthFormat, DepthFormat> formats[] = {
+      {DepthFormat::FloatReversed, DepthFormat::FloatReversed},
+      {DepthFormat::Float, DepthFormat::Float},
+      {DepthFormat::Unorm24, DepthFormat::Unorm24},
+      {DepthFormat::Unorm16, DepthFormat::Unorm16}};
   for (const auto& [stored, encoding] : formats)
     for (Projection p : {Projection::Perspective, Projection::Orthographic})
       for (double f : {50.0, kInf}) {
@@ -36,7 +36,7 @@ TEST(DepthFormulaAgreement, ResolutionAndTiesUseTheSharedDefinition) {
 TEST(DepthFormulaAgreement, ReversedResolutionFarAwayIsRelative) {
   // d/n = 1e7, infinite far: s = n/d, resolution ulp32(s) · d²/n <= d · 2^-23.
   const DepthPlanes planes{true, Projection::Perspective, 1.0, kInf};
-  const double r = depthResolution(StoredDepthFormat::FloatReversed, planes, 1e7);
+  const double r = depthResolution(DepthFormat::FloatReversed, planes, 1e7);
   EXPECT_LE(r, 1e7 * 0x1p-23);
   EXPECT_GE(r, 1e7 * 0x1p-24);
 }

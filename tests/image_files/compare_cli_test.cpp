@@ -71,6 +71,18 @@ TEST_F(CompareCli, JsonWithSceneClassifiesGeometrically) {
   EXPECT_EQ(j["passed"], true);
 }
 
+// The camera options the files were rendered with are accepted as given
+// to render, --size among them; a size that is not the files' is refused
+// in the documented `command line: OPTION: why` form.
+TEST_F(CompareCli, AcceptsTheCameraOptionsUsedForRendering) {
+  auto r = runRastray({"compare", a, b, "--scene", scene, "--spp", "1", "--size", "8", "8", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out)["classification"]["mode"], "geometric");
+  r = runRastray({"compare", a, b, "--scene", scene, "--spp", "1", "--size", "320", "240"});
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(r.err, "command line: --size: 320x240 is not the files' size, 8x8\n");
+}
+
 TEST_F(CompareCli, WithoutSceneSayImageSpace) {
   const auto r = runRastray({"compare", a, b, "--json"});
   ASSERT_EQ(r.status, 0) << r.err;

@@ -43,17 +43,14 @@ TEST(ReversedDepth, RasterStoresTheSharedDefinition) {
       for (double f : {50.0, kInf}) {
         if (p == Projection::Orthographic && std::isinf(f)) continue;
         for (double d : {0.1, 0.37, 1.0, 7.5, 49.0, 1e6}) {
-          EXPECT_EQ(windowDepth(format, p, 0.1, f, d), storedWindowDepth(encodingOf(format), p, 0.1, f, d))
+          EXPECT_EQ(windowDepth(format, p, 0.1, f, d), storedWindowDepth(format, p, 0.1, f, d))
               << toString(format) << " d " << d;
         }
         for (double z : {0.0, 1e-30, 0.001, 0.5, 0.75, 1.0})
-          EXPECT_EQ(minimumResolvableDifference(format, z), depthStep(encodingOf(format), z))
+          EXPECT_EQ(minimumResolvableDifference(format, z), depthStep(format, z))
               << toString(format) << " z " << z;
       }
-  EXPECT_EQ(encodingOf(DepthFormat::FloatReversed), DepthEncoding::FloatReversed);
-  EXPECT_EQ(encodingOf(DepthFormat::Float), DepthEncoding::Float);
-  EXPECT_EQ(encodingOf(DepthFormat::Unorm24), DepthEncoding::Unorm24);
-  EXPECT_EQ(encodingOf(DepthFormat::Unorm16), DepthEncoding::Unorm16);
+  EXPECT_EQ(parseDepthFormat(toString(DepthFormat::Unorm24)), DepthFormat::Unorm24);
 }
 
 }  // namespace
