@@ -22,11 +22,11 @@ void TileRenderer::opaquePass(const TileRect& rect, const std::vector<uint32_t>&
                   target, &n.opaque, coveragePath());
 }
 
-TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,
-                                       const TraceRequest& trace, bool allFronts, ThreadCounters& n) const {
+void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,
+                                const TraceRequest& trace, bool allFronts, TileSamples& samples,
+                                ThreadCounters& n) const {
   const TileRect& rect = index.rect;
   const int spp = grid_.spp;
-  TileSamples samples;
   samples.color.assign(index.count(), glm::vec4(0.0f));
   samples.front.assign(index.count(), SampleHit{});
   // The tile's winning samples in three steps: gather the hits to shade
@@ -118,7 +118,6 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
                              .add("color", traceColor(samples.color[local])));
     }
   }
-  return samples;
 }
 
 }  // namespace rastray

@@ -9,6 +9,8 @@
 
 namespace rastray {
 
+class RasterFrameBuffers;  // raster/frame_buffers.h
+
 enum class DepthFormat { FloatReversed, Float, Unorm24, Unorm16 };  // precision: depth.h
 // Equal depths are decided by (instance, triangle) as if submitted in that
 // order: Less keeps the lower id, LEqual lets the higher win (depth.h).
@@ -45,6 +47,10 @@ struct RasterOptions {
   // tile, setup and edge functions, coverage, depth and MASK tests, shading,
   // blend layers, final colours. Checked once per tile; no sink, no cost.
   TraceRequest trace;
+  // Buffers kept between frames (raster/frame_buffers.h) by a caller that
+  // renders frame after frame and hands each image back; null: every frame
+  // allocates its own. The picture is the same either way.
+  RasterFrameBuffers* frameBuffers = nullptr;
 };
 
 }  // namespace rastray
