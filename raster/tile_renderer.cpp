@@ -40,6 +40,7 @@ TileRenderer::TileRenderer(const Scene& scene, const SceneAnalysis& analysis, co
       grid_(grid),
       setups_(setups),
       rays_(camera),
+      primaryConstants_(camera),
       centre_(centreSampleIndex(options.spp)) {}
 
 namespace {
@@ -122,8 +123,7 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
 }
 
 SampleHit TileRenderer::interpolatedHit(const TriangleSetup& t, const glm::dvec2& pos) const {
-  const glm::dvec2 b = t.baryAt(pos.x, pos.y);
-  return {t.instance, t.triangle, float(t.viewDepthAt(pos.x, pos.y)), float(b.x), float(b.y)};
+  return interpolatedSampleHit(t, pos);
 }
 
 // The depth that orders BLEND layers: the view depth of the stored

@@ -39,6 +39,7 @@
 #include "raster/bin.h"
 #include "raster/coverage.h"
 #include "raster/options.h"
+#include "raster/primary_samples.h"
 #include "raster/resolve.h"
 #include "raster/setup.h"
 
@@ -174,7 +175,8 @@ class TileRenderer {
   const Shader& shader_;
   const SampleGrid& grid_;
   const std::vector<TriangleSetup>& setups_;
-  PrimaryRays rays_;  // camera_'s primary rays (bit-identical to Camera::primaryRay)
+  PrimaryRays rays_;                      // camera_'s primary rays (bit-identical to Camera::primaryRay)
+  PrimaryRayConstants primaryConstants_;  // the same rays for primarySamples' lanes
   int centre_;
 };
 
