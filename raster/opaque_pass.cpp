@@ -9,6 +9,7 @@
 
 #include "common/primary_refinement.h"
 #include "common/shading_kernel.h"
+#include "raster/primary_samples.h"
 #include "raster/tile_renderer.h"
 
 namespace rastray {
@@ -22,11 +23,11 @@ void TileRenderer::opaquePass(const TileRect& rect, const std::vector<uint32_t>&
                   target, &n.opaque, coveragePath());
 }
 
-TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,
-                                       const TraceRequest& trace, bool allFronts, ThreadCounters& n) const {
+void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,
+                                const TraceRequest& trace, bool allFronts, TileSamples& samples,
+                                ThreadCounters& n) const {
   const TileRect& rect = index.rect;
   const int spp = grid_.spp;
-  TileSamples samples;
   samples.color.assign(index.count(), glm::vec4(0.0f));
   samples.front.assign(index.count(), SampleHit{});
   // The tile's winning samples in three steps: gather the hits to shade
@@ -41,16 +42,28 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
     uint32_t local;    // TileSampleIndex
     uint32_t request;  // index into `requests`
   };
+  thread_local std::vector<uint32_t> winners;       // setup per request
+  thread_local std::vector<glm::dvec2> positions;   // image position per request
+  thread_local std::vector<uint32_t> requestLocal;  // the sample a request is shaded at
   thread_local std::vector<SampleHit> hits;         // interpolated, per request
   thread_local std::vector<Ray> rays;               // primary ray through the sample, per request
   thread_local std::vector<glm::dvec2> footprints;  // image position of the texture footprint
   thread_local std::vector<ShadeHit> requests;      // refined (refinePrimaryHits)
   thread_local std::vector<glm::vec4> colors;
   thread_local std::vector<Assignment> assignments;
-  hits.clear();
-  rays.clear();
+  winners.clear();
+  positions.clear();
+  requestLocal.clear();
   footprints.clear();
   assignments.clear();
+  const auto addRequest = [&](uint32_t win, uint32_t local, const glm::dvec2& pos,
+                              const glm::dvec2& footprint) {
+    winners.push_back(win);
+    positions.push_back(pos);
+    requestLocal.push_back(local);
+    footprints.push_back(footprint);
+    return uint32_t(winners.size() - 1);
+  };
   std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, request)
   for (int py = rect.y0; py < rect.y1; ++py)
     for (int px = rect.x0; px < rect.x1; ++px) {
@@ -60,11 +73,11 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
       for (int s = 0; s < spp; ++s) {
         const uint32_t win = target.winners[target.index(px, py, s)];
         if (win == kNoSetup) continue;
-        const TriangleSetup& t = setups_[win];
         const uint32_t local = index(px, py, s);
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
         uint32_t request;
         if (options_.shadingRate == ShadingRate::Pixel) {
+          const TriangleSetup& t = setups_[win];
           auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
                                  [&](const auto& e) { return e.first == t.id(); });
           if (it != pixelCache.end()) {
@@ -74,25 +87,23 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
             if (allFronts || s == centre_ || traced) samples.front[local] = interpolatedHit(t, pos);
           } else {
             // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
-            const SampleHit hit = interpolatedHit(t, pos);
-            samples.front[local] = hit;
-            request = uint32_t(hits.size());
-            hits.push_back(hit);
-            rays.push_back(rays_(pos));
-            footprints.push_back(corner + glm::dvec2(0.5));
+            request = addRequest(win, local, pos, corner + glm::dvec2(0.5));
             pixelCache.emplace_back(t.id(), request);
           }
         } else {
-          const SampleHit hit = interpolatedHit(t, pos);
-          samples.front[local] = hit;
-          request = uint32_t(hits.size());
-          hits.push_back(hit);
-          rays.push_back(rays_(pos));
-          footprints.push_back(pos);
+          request = addRequest(win, local, pos, pos);
         }
         assignments.push_back({local, request});
       }
     }
+  // Each request's interpolated hit and primary ray in double lanes
+  // (interpolatedHit's and PrimaryRays' bits: raster/primary_samples.h).
+  const size_t count = winners.size();
+  hits.resize(count);
+  rays.resize(count);
+  primarySamples(primaryConstants_, setups_.data(), winners.data(), positions.data(), count, hits.data(),
+                 rays.data());
+  for (size_t r = 0; r < count; ++r) samples.front[requestLocal[r]] = hits[r];
   // Refined on their planes in double lanes (refinePrimaryHit's bits).
   requests.resize(hits.size());
   refinePrimaryHits(scene_, rays.data(), hits.data(), footprints.data(), hits.size(), requests.data());
@@ -118,7 +129,6 @@ TileSamples TileRenderer::shadeVisible(const TileSampleIndex& index, const Depth
                              .add("color", traceColor(samples.color[local])));
     }
   }
-  return samples;
 }
 
 }  // namespace rastray

@@ -11,6 +11,8 @@
 
 namespace rastray {
 
+class RasterFrameBuffers;  // raster/frame_buffers.h
+
 // DepthFormat (what the depth buffer stores, its precision): common/depth_formula.h.
 // Equal depths are decided by (instance, triangle) as if submitted in that
 // order: Less keeps the lower id, LEqual lets the higher win (depth.h).
@@ -50,6 +52,10 @@ struct RasterOptions {
   // Stops the render at its next tile when cancelled (common/interrupt.h);
   // nullptr: a signal alone stops it. Must outlive the render.
   const CancelToken* cancel = nullptr;
+  // Buffers kept between frames (raster/frame_buffers.h) by a caller that
+  // renders frame after frame and hands each image back; null: every frame
+  // allocates its own. The picture is the same either way.
+  RasterFrameBuffers* frameBuffers = nullptr;
 };
 
 }  // namespace rastray

@@ -15,6 +15,7 @@
 #include "common/parallel.h"
 #include "raster/bin.h"
 #include "raster/clip.h"
+#include "raster/frame_buffers.h"
 #include "raster/report.h"
 #include "raster/setup.h"
 #include "raster/shadow_map.h"
@@ -127,8 +128,12 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   // Every tile: pass 1, shading, pass 2, compositing, resolve.
   start = Clock::now();
   const TileRenderer renderer(scene, analysis, camera, options, shader, grid, setups);
-  DepthTarget target(camera.width, camera.height, options.spp);
-  out.image = FlatImage(camera.width, camera.height);
+  // Reused storage holds the last frame's values: each tile clears its
+  // rectangle of the target, and the resolve writes every pixel.
+  FrameBufferLease buffers(options.frameBuffers);
+  bool targetCleared = false;
+  DepthTarget& target = buffers.target(camera.width, camera.height, options.spp, &targetCleared);
+  out.image = buffers.image(camera.width, camera.height);
   std::vector<std::vector<DeepSample>> deep(options.keepSamples ? size_t(tiles.count()) : 0);
   std::vector<std::vector<uint32_t>> deepCounts(deep.size());
   tbb::enumerable_thread_specific<ThreadCounters> counters;
@@ -141,7 +146,7 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
     const TileBins bins{opaqueBins[t], analysis.transparency ? &blendBins[t] : nullptr};
     const TileOutputs outputs{&out.image, options.keepSamples ? &deep[t] : nullptr,
                               options.keepSamples ? &deepCounts[t] : nullptr, hits};
-    renderer.render(tiles.rect(tile), bins, &target, outputs, counters.local());
+    renderer.render(tiles.rect(tile), bins, &target, !targetCleared, outputs, counters.local());
   });
   throwIfStopped(options.cancel);
   const double tileSeconds = secondsSince(start);

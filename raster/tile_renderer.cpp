@@ -3,6 +3,7 @@
 // triangles with.
 #include "raster/tile_renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -39,10 +40,35 @@ TileRenderer::TileRenderer(const Scene& scene, const SceneAnalysis& analysis, co
       grid_(grid),
       setups_(setups),
       rays_(camera),
+      primaryConstants_(camera),
       centre_(centreSampleIndex(options.spp)) {}
 
-void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarget* target,
+namespace {
+
+// Sets the tile's samples of the depth target to the cleared state (far
+// key, no winner): reused storage holds the previous frame's.
+void clearTileTarget(const TileRect& rect, DepthTarget* target) {
+  const size_t width = size_t(rect.x1 - rect.x0) * size_t(target->spp);
+  for (int y = rect.y0; y < rect.y1; ++y) {
+    const size_t first = target->index(rect.x0, y, 0);
+    std::fill_n(target->keys.begin() + ptrdiff_t(first), width, kClearDepthKey);
+    if (!target->winners.empty()) std::fill_n(target->winners.begin() + ptrdiff_t(first), width, kNoSetup);
+  }
+}
+
+// The tile's samples, kept per thread so a tile allocates nothing once they
+// have grown; a tile that finds them in use (a nested tile on the same
+// thread) takes its own.
+struct SampleScratch {
+  TileSamples samples;
+  bool busy = false;
+};
+
+}  // namespace
+
+void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarget* target, bool clearTarget,
                           const TileOutputs& out, ThreadCounters& n) const {
+  if (clearTarget) clearTileTarget(rect, target);
   const TileSampleIndex index{rect, grid_.spp};
   // The one trace check of the tile: an empty request unless the traced
   // pixel lies here.
@@ -66,7 +92,19 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
   const Clock::time_point t0 = Clock::now();
   opaquePass(rect, bins.opaque, trace, target, n);
   const Clock::time_point t1 = Clock::now();
-  TileSamples samples = shadeVisible(index, *target, trace, out.hits != nullptr, n);
+  thread_local SampleScratch scratch;
+  TileSamples own;
+  const bool reuse = !scratch.busy;
+  TileSamples& samples = reuse ? scratch.samples : own;
+  scratch.busy = true;
+  struct Release {
+    SampleScratch& s;
+    bool reused;
+    ~Release() {
+      if (reused) s.busy = false;
+    }
+  } release{scratch, reuse};
+  shadeVisible(index, *target, trace, out.hits != nullptr, samples, n);
   const Clock::time_point t2 = Clock::now();
   std::vector<BlendLayer> layers;
   if (bins.blend && !bins.blend->empty()) layers = transparencyPass(index, *bins.blend, *target, n);
@@ -85,8 +123,7 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
 }
 
 SampleHit TileRenderer::interpolatedHit(const TriangleSetup& t, const glm::dvec2& pos) const {
-  const glm::dvec2 b = t.baryAt(pos.x, pos.y);
-  return {t.instance, t.triangle, float(t.viewDepthAt(pos.x, pos.y)), float(b.x), float(b.y)};
+  return interpolatedSampleHit(t, pos);
 }
 
 // The depth that orders BLEND layers: the view depth of the stored

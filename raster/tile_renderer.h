@@ -39,6 +39,7 @@
 #include "raster/bin.h"
 #include "raster/coverage.h"
 #include "raster/options.h"
+#include "raster/primary_samples.h"
 #include "raster/resolve.h"
 #include "raster/setup.h"
 
@@ -101,9 +102,10 @@ class TileRenderer {
 
   // Pass 1, deferred shading, pass 2, compositing, resolve, hits and deep
   // samples of one tile. `target` is the frame's depth target; the tile
-  // writes only its own samples.
-  void render(const TileRect& rect, const TileBins& bins, DepthTarget* target, const TileOutputs& out,
-              ThreadCounters& n) const;
+  // writes only its own samples, and first clears them when `clearTarget`
+  // (reused storage: raster/frame_buffers.h).
+  void render(const TileRect& rect, const TileBins& bins, DepthTarget* target, bool clearTarget,
+              const TileOutputs& out, ThreadCounters& n) const;
 
  private:
   // Sampling helpers (tile_renderer.cpp).
@@ -131,8 +133,9 @@ class TileRenderer {
   // `allFronts`: every sample's front hit is read (per-sample hits out);
   // else only the centre sample's and the traced pixel's need to be set
   // where shading once per pixel reuses a colour.
-  TileSamples shadeVisible(const TileSampleIndex& index, const DepthTarget& target, const TraceRequest& trace,
-                           bool allFronts, ThreadCounters& n) const;
+  // Fills `samples` (any previous contents are replaced).
+  void shadeVisible(const TileSampleIndex& index, const DepthTarget& target, const TraceRequest& trace,
+                    bool allFronts, TileSamples& samples, ThreadCounters& n) const;
 
   // Pass 2 (transparency.cpp): layers sorted by local index, front to back
   // within a sample.
@@ -172,7 +175,8 @@ class TileRenderer {
   const Shader& shader_;
   const SampleGrid& grid_;
   const std::vector<TriangleSetup>& setups_;
-  PrimaryRays rays_;  // camera_'s primary rays (bit-identical to Camera::primaryRay)
+  PrimaryRays rays_;                      // camera_'s primary rays (bit-identical to Camera::primaryRay)
+  PrimaryRayConstants primaryConstants_;  // the same rays for primarySamples' lanes
   int centre_;
 };
 

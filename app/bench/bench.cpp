@@ -7,11 +7,13 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <utility>
 
 #include <tbb/global_control.h>
 
 #include "app/report/csv.h"
 #include "common/memory_budget.h"
+#include "raster/frame_buffers.h"
 
 namespace rastray {
 
@@ -65,6 +67,10 @@ BenchResult runBench(const BenchRequest& request) {
   RasterOptions raster = s.raster;
   RayOptions ray = s.ray;
   raster.keepSamples = ray.keepSamples = s.keepSamples;
+  // Frame after frame, as an explorer renders: the depth target and the
+  // image's storage are reused instead of allocated and filled per frame.
+  RasterFrameBuffers frameBuffers;
+  raster.frameBuffers = &frameBuffers;
   FrameRenderer renderer(scene, s, raster, ray);
   r.width = renderer.camera().width;
   r.height = renderer.camera().height;
@@ -92,6 +98,7 @@ BenchResult runBench(const BenchRequest& request) {
       r.passesRun = std::move(output.passesRun);
       r.passesLeftOut = std::move(output.passesLeftOut);
     }
+    frameBuffers.recycle(std::move(output.image));
     if (request.progress) request.progress(i + 1, count);
     const int timed = i + 1 - request.warmup;
     if (request.afterRound && timed > 0 && timed % request.frames == 0)

@@ -1,0 +1,117 @@
+// Frame buffers reused between frames (raster/frame_buffers.h): a frame
+// rendered into another frame's stale storage is bit-identical to one
+// rendered into fresh buffers, and the storage really is reused.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <thread>
+
+#include "common/gltf/loader.h"
+#include "raster/frame_buffers.h"
+#include "raster_test_util.h"
+
+namespace rastray {
+namespace {
+
+void expectSameImage(const FlatImage& a, const FlatImage& b, const std::string& what) {
+  ASSERT_EQ(a.width, b.width) << what;
+  ASSERT_EQ(a.height, b.height) << what;
+  ASSERT_EQ(a.color.size(), b.color.size()) << what;
+  EXPECT_TRUE(a.hasColor && b.hasColor) << what;
+  // Bits, not values: NaN-free, but +inf depth and -0 must match too.
+  EXPECT_EQ(0, std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(a.color[0]))) << what;
+  EXPECT_EQ(0, std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float))) << what;
+  EXPECT_EQ(a.instance, b.instance) << what;
+  EXPECT_EQ(a.triangle, b.triangle) << what;
+}
+
+// A single triangle over most of an empty background: where the previous
+// frame (the Cornell box, which fills the image) left keys, winners,
+// colours and ids, this frame must show background.
+Scene oneTriangle() {
+  Scene scene;
+  test::addMesh(scene, {{-0.8f, -0.8f, -2.0f}, {0.8f, -0.8f, -2.0f}, {0.0f, 0.8f, -2.0f}}, {{0, 1, 2}},
+                test::colored(glm::vec4(0.2f, 0.6f, 0.9f, 1.0f)));
+  return scene;
+}
+
+TEST(FrameBuffers, StaleStorageGivesTheFreshFrameBitForBit) {
+  const Scene cornell = loadScene(test::scenePath("cornell-box.gltf"));
+  const Scene triangle = oneTriangle();
+  RasterFrameBuffers pool;
+  for (const int spp : {1, 4}) {
+    for (const auto& [w, h] : {std::pair{96, 72}, std::pair{130, 67}}) {
+      const std::string what = std::to_string(w) + "x" + std::to_string(h) + " spp " + std::to_string(spp);
+      RasterOptions options;
+      options.spp = spp;
+      options.shadows = ShadowMode::None;
+      const Camera cornellCamera = makeCamera(cornell, {}, w, h);
+      const Camera triangleCamera = test::orthoCamera(w, 1.0);
+      Camera camera = triangleCamera;
+      camera.height = h;
+      camera.ymag = double(h) / double(w);
+
+      const RenderOutput freshCornell = test::render(cornell, cornellCamera, options);
+      const RenderOutput freshTriangle = test::render(triangle, camera, options);
+
+      RasterOptions pooled = options;
+      pooled.frameBuffers = &pool;
+      // Cornell, triangle, Cornell, triangle through the same storage.
+      for (int round = 0; round < 2; ++round) {
+        RenderOutput a = test::render(cornell, cornellCamera, pooled);
+        expectSameImage(a.image, freshCornell.image, what + " cornell round " + std::to_string(round));
+        const void* storage = a.image.color.data();
+        pool.recycle(std::move(a.image));
+        RenderOutput b = test::render(triangle, camera, pooled);
+        expectSameImage(b.image, freshTriangle.image, what + " triangle round " + std::to_string(round));
+        // Same size: the recycled image's storage served this frame.
+        EXPECT_EQ(storage, static_cast<const void*>(b.image.color.data())) << what;
+        pool.recycle(std::move(b.image));
+      }
+    }
+  }
+}
+
+// The wireframe reads the whole depth target after the tiles: the reused
+// target must be cleared everywhere it reads.
+TEST(FrameBuffers, WireframeOverStaleTargetMatchesFresh) {
+  const Scene cornell = loadScene(test::scenePath("cornell-box.gltf"));
+  const Scene triangle = oneTriangle();
+  RasterOptions options;
+  options.shadows = ShadowMode::None;
+  options.wireframe = true;
+  const Camera camera = test::orthoCamera(80, 1.0);
+  const RenderOutput fresh = test::render(triangle, camera, options);
+  RasterFrameBuffers pool;
+  RasterOptions pooled = options;
+  pooled.frameBuffers = &pool;
+  RenderOutput first = test::render(cornell, makeCamera(cornell, {}, 80, 80), pooled);
+  pool.recycle(std::move(first.image));
+  const RenderOutput second = test::render(triangle, camera, pooled);
+  expectSameImage(second.image, fresh.image, "wireframe");
+}
+
+// A pool in use by one frame: a second frame at the same time takes its
+// own buffers and still gets its picture.
+TEST(FrameBuffers, BusyPoolFallsBackToOwnBuffers) {
+  const Scene triangle = oneTriangle();
+  const Camera camera = test::orthoCamera(64, 1.0);
+  RasterOptions options;
+  options.shadows = ShadowMode::None;
+  const RenderOutput fresh = test::render(triangle, camera, options);
+  RasterFrameBuffers pool;
+  FrameBufferLease held(&pool);  // the pool is busy
+  FrameBufferLease second(&pool);
+  bool cleared = false;
+  const DepthTarget& target = second.target(64, 64, 1, &cleared);
+  EXPECT_TRUE(cleared);  // own, freshly filled
+  EXPECT_EQ(target.keys.size(), size_t(64 * 64));
+  RasterOptions pooled = options;
+  pooled.frameBuffers = &pool;
+  const RenderOutput busy = test::render(triangle, camera, pooled);
+  expectSameImage(busy.image, fresh.image, "busy pool");
+}
+
+}  // namespace
+}  // namespace rastray
