@@ -141,7 +141,7 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
     {"--cull", kAllRenderers, OptionCondition::Always, "Cull single-sided triangles: back, front or none",
      RASTRAY_BIND(cmd.add_option(name, s.cull, help)->capture_default_str())},
     {"--shadows", kAllRenderers, OptionCondition::Always,
-     "map (shadow maps: raster, hybrid), rays (raytrace, hybrid) or none (raster, hybrid); default map, "
+     "map (shadow maps: raster, hybrid), rays (raytrace, hybrid) or none (every renderer); default map, "
      "rays for raytrace and hybrid",
      RASTRAY_BIND(cmd.add_option(name, s.shadows, help))},
     // Rasterized primary visibility.
@@ -186,6 +186,10 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
      "error-bound (from the hit's triangle, pbrt-v4) or float-ulps (from the hit point, Ray Tracing Gems "
      "ch. 6): where secondary and shadow rays start",
      RASTRAY_BIND(cmd.add_option(name, s.rayOffset, help)->capture_default_str())},
+    {"--terminator", kTraced, OptionCondition::Always,
+     "shading-normal (lift ray origins towards the smooth surface the vertex normals describe, Hanika "
+     "2021) or none (start on the flat triangle: low-poly smooth meshes show facets in shadow edges)",
+     RASTRAY_BIND(cmd.add_option(name, s.terminator, help)->capture_default_str())},
     // Traced primary rays.
     {"--no-packets", kRaytrace, OptionCondition::Always,
      "Trace primary rays one by one instead of in coherent packets",
@@ -259,8 +263,9 @@ RenderSettings renderSettingsFrom(const std::vector<std::string>& args, bool all
 }
 
 ShadowMode RenderSettings::shadowModeFor(RendererKind kind) const {
-  if (kind == RendererKind::Raytrace) return ShadowMode::Rays;
-  if (kind == RendererKind::Hybrid && allRenderers) return ShadowMode::Rays;
+  const ShadowMode traced = ray.shadows ? ShadowMode::Rays : ShadowMode::None;
+  if (kind == RendererKind::Raytrace) return traced;
+  if (kind == RendererKind::Hybrid && allRenderers) return traced;
   return raster.shadows;
 }
 
@@ -294,6 +299,9 @@ void RenderSettings::finish() {
   ray.offset = pick<RayOffsetMethod>(
       "--ray-offset", rayOffset,
       {{"error-bound", RayOffsetMethod::ErrorBound}, {"float-ulps", RayOffsetMethod::FloatUlps}});
+  ray.terminator = pick<ShadowTerminator>(
+      "--terminator", terminator,
+      {{"shading-normal", ShadowTerminator::ShadingNormal}, {"none", ShadowTerminator::None}});
   keptLights = parseLightList(lights);
   if (!debugPixelXY.empty()) debugPixel = glm::ivec2(debugPixelXY[0], debugPixelXY[1]);
   memory = maxMemory.empty() ? MemoryBudget::machineDefault() : MemoryBudget::parse(maxMemory);
@@ -331,8 +339,9 @@ void RenderSettings::finish() {
     badOption("--transparency", "'" + transparency + "' is not one of sorted, peel:N, exact");
   }
 
-  // Shadows: map and none need the rasterizer, rays a ray tracer (the ray
-  // caster traces shadow rays always). raster.shadows is the rasterizer's
+  // Shadows: map needs the rasterizer, rays a ray tracer, none applies to
+  // every renderer (the ray caster then traces no shadow rays, nor does
+  // hybrid for its secondary hits). raster.shadows is the rasterizer's
   // technique; with allRenderers, that of the rasterizer alone.
   const bool shadowsGiven = !shadows.empty();
   const RendererKind rasterizing = allRenderers ? RendererKind::Raster : renderer;
@@ -342,11 +351,14 @@ void RenderSettings::finish() {
                        : rasterizing == RendererKind::Raster ? "map"
                                                              : "rays",
                        {{"map", ShadowMode::Map}, {"rays", ShadowMode::Rays}, {"none", ShadowMode::None}});
-  const RendererSet shadowModeRenderers = shadowMode == ShadowMode::Rays ? kTraced : kRasterized;
+  const RendererSet shadowModeRenderers = shadowMode == ShadowMode::Rays   ? kTraced
+                                          : shadowMode == ShadowMode::None ? kAllRenderers
+                                                                           : kRasterized;
   if (!allRenderers && !(shadowModeRenderers & rendererBit(renderer)))
     badOption("--shadows", "'" + shadows + "' applies to " + describeRenderers(shadowModeRenderers) +
                                ", not to --renderer " + toString(renderer));
   raster.shadows = allRenderers && shadowMode == ShadowMode::Rays ? ShadowMode::Map : shadowMode;
+  ray.shadows = shadowMode != ShadowMode::None;
   if (!shadowBias.empty()) {
     raster.shadowBiasConstant = shadowBias[0];
     raster.shadowBiasSlope = shadowBias[1];

@@ -77,7 +77,7 @@ struct RenderSettings {
   std::string shadows;  // empty: map for raster, rays for hybrid
   std::string cull = "none", depthFormat = "float-reversed", depthFunc = "less", shadingRate = "sample";
   std::string textureFilter = "sampler";
-  std::string origin = "camera", rayOffset = "error-bound";
+  std::string origin = "camera", rayOffset = "error-bound", terminator = "shading-normal";
   std::string lights = "all";                     // --lights: all, none or indices "0,2"
   std::optional<std::vector<size_t>> keptLights;  // set by finish(): nullopt keeps all
   RenderOrigin renderOrigin = RenderOrigin::Camera;
