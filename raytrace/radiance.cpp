@@ -15,7 +15,12 @@ namespace rastray {
 namespace {
 
 // Defined below, each after the function that uses it.
-glm::vec3 secondaryRayOrigin(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction);
+glm::vec3 secondaryRayOrigin(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction,
+                             glm::dvec3* sideOut = nullptr);
+FloatTriangle floatTriangle(const Scene& scene, uint32_t instance, uint32_t triangle);
+bool leaveSeam(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction,
+               const GatheredHit& first, glm::vec3* origin, FloatTriangle* planes, glm::dvec3* sides,
+               size_t* count);
 Ray secondaryRay(const glm::vec3& origin, const glm::dvec3& direction, double tFar);
 Composited composite(const CasterState& state, const RayTreeContext& context, int depth, float throughput,
                      const HitGather& g, const std::vector<SurfaceCrossing>& crossings, DeepTarget deep);
@@ -37,9 +42,23 @@ glm::vec3 traceRadiance(const CasterState& state, const RayTreeContext& context,
   std::vector<SurfaceCrossing>& crossings = use.level().crossings;
   g.mode = GatherMode::Radiance;
   g.primary = false;
-  g.ray = secondaryRay(secondaryRayOrigin(state, from, dir), dir, std::numeric_limits<double>::infinity());
+  constexpr double kNoEnd = std::numeric_limits<double>::infinity();
+  glm::dvec3 side;
+  glm::vec3 origin = secondaryRayOrigin(state, from, dir, &side);
+  g.ray = secondaryRay(origin, dir, kNoEnd);
   g.hits.clear();
-  collectCrossings(state, g, intersectClosest(state, g, /*coherent=*/false), &crossings);
+  GatheredHit first = intersectClosest(state, g, /*coherent=*/false);
+  // A seam neighbour the ray leaves is not what it sees (ray_offset.h,
+  // "Concave seams"): off its plane too, and again.
+  FloatTriangle planes[4] = {floatTriangle(state.scene, from.instance, from.triangle)};
+  glm::dvec3 sides[4] = {side};
+  size_t count = 1;
+  while (count < 4 && leaveSeam(state, from, dir, first, &origin, planes, sides, &count)) {
+    g.ray = secondaryRay(origin, dir, kNoEnd);
+    g.hits.clear();
+    first = intersectClosest(state, g, /*coherent=*/false);
+  }
+  collectCrossings(state, g, first, &crossings);
   return glm::vec3(shadeRay(state, context, kind, depth, throughput, g, crossings, DeepTarget{}).color);
 }
 
@@ -51,9 +70,26 @@ glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& con
   HitGather& g = use.level().gather;
   g.mode = GatherMode::Shadow;
   g.primary = false;
-  g.ray = secondaryRay(secondaryRayOrigin(state, point, dir), dir, distance);
+  glm::dvec3 side;
+  glm::vec3 origin = secondaryRayOrigin(state, point, dir, &side);
+  g.ray = secondaryRay(origin, dir, distance);
   g.hits.clear();
-  const bool blocked = traceOcclusion(state, g);
+  bool blocked = traceOcclusion(state, g);
+  // Blocked: by a seam neighbour the ray leaves (ray_offset.h, "Concave
+  // seams")? The first hit says; then off its plane too, and again.
+  FloatTriangle planes[4] = {floatTriangle(state.scene, point.instance, point.triangle)};
+  glm::dvec3 sides[4] = {side};
+  size_t count = 1;
+  while (blocked && count < 4) {
+    g.mode = GatherMode::Radiance;
+    g.hits.clear();
+    const GatheredHit first = intersectClosest(state, g, /*coherent=*/false);
+    g.mode = GatherMode::Shadow;
+    g.hits.clear();
+    if (!leaveSeam(state, point, dir, first, &origin, planes, sides, &count)) break;
+    g.ray = secondaryRay(origin, dir, distance);
+    blocked = traceOcclusion(state, g);
+  }
   glm::vec3 result(blocked ? 0.0f : 1.0f);
   // Each surface's transmittance was evaluated by the filter that let the
   // ray through it (GatheredHit::transmittance): not again here.
@@ -72,16 +108,69 @@ glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& con
 namespace {
 
 // Where a secondary or shadow ray leaving `from` along `direction`
-// starts (raytrace/ray_offset.h): the one place both kinds get it.
-glm::vec3 secondaryRayOrigin(const CasterState& state, const SurfacePoint& from,
-                             const glm::dvec3& direction) {
-  const glm::dvec3 side = offsetSideNormal(from.geometricNormal, direction);
-  if (state.options.offset == RayOffsetMethod::FloatUlps)
-    return floatUlpsRayOrigin(glm::vec3(from.position), glm::vec3(side));
+// starts (raytrace/ray_offset.h): the one place both kinds get it, hybrid's
+// included.
+glm::vec3 secondaryRayOrigin(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction,
+                             glm::dvec3* sideOut) {
+  glm::dvec3 side = offsetSideNormal(from.geometricNormal, direction);
   const Scene& scene = state.scene;
   const glm::uvec3 t = scene.triangle(from.instance, from.triangle);
   const FloatTriangle triangle = {scene.positions[t.x], scene.positions[t.y], scene.positions[t.z]};
-  return errorBoundRayOrigin(triangle, from.position, from.b1, from.b2, side);
+  glm::dvec3 lift(0.0);
+  if (state.options.terminator == ShadowTerminator::ShadingNormal &&
+      scene.instances[from.instance].normals == NormalSource::Authored) {
+    // Lifted towards the tangent planes on the side of the shading normals
+    // the ray leaves; the origin then sits on that side of the plane.
+    const double s = glm::dot(from.shadingNormal, direction) >= 0.0 ? 1.0 : -1.0;
+    const glm::dvec3 liftSide = s * from.geometricNormal;
+    lift = terminatorLift(triangle, {scene.normals[t.x], scene.normals[t.y], scene.normals[t.z]},
+                          from.position, from.b1, from.b2, s);
+    if (!(glm::dot(lift, liftSide) > 0.0)) {
+      lift = glm::dvec3(0.0);
+    } else if (glm::dot(liftSide, side) < 0.0) {
+      // The terminator: the ray leaves through the other face of the flat
+      // triangle. From above it, the ray must not come back through it.
+      if (liftedRayCrossesItsTriangle(triangle, from.position, lift, direction))
+        lift = glm::dvec3(0.0);
+      else
+        side = liftSide;
+    }
+  }
+  if (sideOut) *sideOut = side;
+  if (state.options.offset == RayOffsetMethod::FloatUlps)
+    return floatUlpsRayOrigin(glm::vec3(from.position + lift), glm::vec3(side));
+  return errorBoundRayOrigin(triangle, from.position, from.b1, from.b2, side, lift);
+}
+
+FloatTriangle floatTriangle(const Scene& scene, uint32_t instance, uint32_t triangle) {
+  const glm::uvec3 t = scene.triangle(instance, triangle);
+  return {scene.positions[t.x], scene.positions[t.y], scene.positions[t.z]};
+}
+
+// Whether `first`, the first surface a ray from `from` along `direction`
+// met, is a seam neighbour the ray leaves (ray_offset.h, "Concave seams"):
+// its plane passes through the point within the point's error, and the
+// ray goes to the side of it where the point's own surface lies. If so,
+// adds its plane to planes/sides (count < 4 on entry) and moves *origin
+// off all of them.
+bool leaveSeam(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction,
+               const GatheredHit& first, glm::vec3* origin, FloatTriangle* planes, glm::dvec3* sides,
+               size_t* count) {
+  if (first.instance == kNoId) return false;
+  const FloatTriangle other = floatTriangle(state.scene, first.instance, first.triangle);
+  for (size_t i = 0; i < *count; ++i)
+    if (planes[i] == other) return false;  // its own surface, or one already left: a real hit
+  if (!(planeDistance(other, from.position) <= seamTolerance(planes[0], from.position, *origin)))
+    return false;
+  const glm::dvec3 side = seamSide(planes[0], other, direction);
+  if (!(glm::dot(side, direction) > 0.0)) return false;  // towards the neighbour's far side: blocked
+  planes[*count] = other;
+  sides[*count] = side;
+  ++*count;
+  const glm::vec3 moved = offsetOffPlanes(planes, sides, *count, *origin);
+  if (moved == *origin) return false;
+  *origin = moved;
+  return true;
 }
 
 // A secondary or shadow ray from `origin` (float, as Embree traces it).

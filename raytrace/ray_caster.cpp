@@ -34,7 +34,7 @@ void reportPasses(const CasterState& state, RenderOutput* out) {
         if (d.work == work) out->passesLeftOut.push_back(name + ": " + d.reason);
   };
   const ShadingOptions& shading = state.options.shading;
-  pass(a.shadows, "shadow rays", Work::Shadows);
+  pass(a.shadows, "shadow rays", Work::Shadows, state.options.shadows ? nullptr : "--shadows none");
   pass(a.reflection, "reflection rays", Work::ReflectionRays,
        shading.reflection ? nullptr : "--no-reflection");
   pass(a.refraction, "refraction rays", Work::RefractionRays,
@@ -52,7 +52,8 @@ void reportPasses(const CasterState& state, RenderOutput* out) {
 // so they are recorded; their counts are dropped.
 class TracedRayTree : public SecondaryRayTracer, public LightVisibility {
  public:
-  explicit TracedRayTree(const CasterState& state) : state_(state), shader_(*state.shader, this, this) {}
+  explicit TracedRayTree(const CasterState& state)
+      : state_(state), shader_(*state.shader, state.options.shadows ? this : nullptr, this) {}
 
   // The Shader holds these callbacks as const objects; the counts and the
   // tree they record into are this object's own, used on one thread.
@@ -87,6 +88,10 @@ std::string contributionText(const glm::vec4& c) {
 
 const char* toString(RayOffsetMethod method) {
   return method == RayOffsetMethod::ErrorBound ? "error-bound" : "float-ulps";
+}
+
+const char* toString(ShadowTerminator terminator) {
+  return terminator == ShadowTerminator::None ? "none" : "shading-normal";
 }
 
 // --- RayTreeRecorder: the one place a RayRecord is written ----------------------
@@ -165,8 +170,9 @@ void RayCaster::bind(const Camera& camera, const RayOptions& options) {
   state.camera = camera;
   state.primaryRays.emplace(state.camera);
   state.options = options;
-  state.shader =
-      std::make_unique<Shader>(state.scene, state.analysis, state.camera, options.shading, this, this);
+  // Without shadows the Shader gets no visibility callback: every light unoccluded.
+  state.shader = std::make_unique<Shader>(state.scene, state.analysis, state.camera, options.shading,
+                                          options.shadows ? this : nullptr, this);
   resetCounters();  // each thread's scratch is kept (warm) across binds
   state.bound = true;
 }

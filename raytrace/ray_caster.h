@@ -52,7 +52,12 @@
 // - Shadow rays (rtcOccluded1) run to the light (distance, or +inf for
 //   directional lights); occlusion filters accept opaque hits (blocked)
 //   and collect the rest, whose Shader::shadowTransmittance values multiply
-//   (BLEND 1 − α, refractive transmission × C; SPEC §5).
+//   (BLEND 1 − α, refractive transmission × C; SPEC §5). A blocked one
+//   asks for its first hit (one rtcIntersect1): when that surface passes
+//   through the lit point and the ray leaves it (a concave seam, ray_offset.h)
+//   the origin moves off it too and the ray is traced again. RayOptions::
+//   shadows false (--shadows none): no shadow rays, every light unoccluded,
+//   the pass reported left out.
 // - Secondary and shadow rays (radiance(), transmittance(): the only
 //   secondary-ray origins, hybrid's included) start on the side they leave,
 //   tnear 0, at the origin RayOptions::offset picks (raytrace/ray_offset.h):
@@ -63,9 +68,11 @@
 //   surface it leaves again, for every direction leaving the plane by more
 //   than ~1e-5 (times the triangle's aspect ratio); FloatUlps the Ray
 //   Tracing Gems ch. 6 offset of 256 ULPs of the hit point's own
-//   coordinates (16 units at 1e6). They are shaded at the depth the
-//   Shader gives them; --max-depth and the throughput cut-off come from
-//   ShadingOptions.
+//   coordinates (16 units at 1e6). On meshes with authored normals the
+//   point is first lifted towards the smooth surface the normals describe
+//   (RayOptions::terminator, ray_offset.h "The shadow terminator"). They
+//   are shaded at the depth the Shader gives them; --max-depth and the
+//   throughput cut-off come from ShadingOptions.
 // - Deep samples (keepSamples): for every sample, every surface its primary
 //   ray composited, front to back, each with its OWN unattenuated
 //   premultiplied colour (what Shader::shade returns for it) and its
@@ -123,9 +130,22 @@ enum class RayOffsetMethod {
 };
 const char* toString(RayOffsetMethod method);
 
+// Where a secondary or shadow ray starts on a mesh with interpolated
+// normals (raytrace/ray_offset.h, "The shadow terminator").
+enum class ShadowTerminator {
+  None,           // on the flat triangle: low-poly smooth meshes show their facets in the shadow edge
+  ShadingNormal,  // lifted towards the vertices' tangent planes (Hanika 2021): a smooth terminator
+};
+const char* toString(ShadowTerminator terminator);
+
 struct RayOptions {
   int spp = 1;
   RayOffsetMethod offset = RayOffsetMethod::ErrorBound;
+  ShadowTerminator terminator = ShadowTerminator::ShadingNormal;
+  // false (--shadows none): no shadow rays; every light reaches every
+  // point unoccluded (V = 1 in common/shading.h), for primary and
+  // secondary hits alike, and the report says the pass was left out.
+  bool shadows = true;
   ShadingOptions shading;            // maxDepth, throughput cut-off, texture filter
   float transparencyCutoff = 1e-4f;  // stop compositing once remaining transmittance is below
   bool keepSamples = false;          // fill RenderOutput::samples (deep output, crossval)

@@ -216,14 +216,46 @@ bool denominatorCertified(const FloatTriangle& triangle, const glm::vec3& o, con
   return sideSign(p, side) * glm::dot(n, dazd(direction)) > bound;
 }
 
+glm::dvec3 terminatorLift(const FloatTriangle& triangle, const VertexNormals& normals,
+                          const glm::dvec3& position, double b1, double b2, double s) {
+  const double b[3] = {std::clamp(1.0 - b1 - b2, 0.0, 1.0), std::clamp(b1, 0.0, 1.0),
+                       std::clamp(b2, 0.0, 1.0)};
+  glm::dvec3 lift(0.0);
+  for (size_t i = 0; i < 3; ++i) {
+    const glm::dvec3 n = s * glm::dvec3(normals[i]);
+    // How far P lies below the tangent plane at vertex i (0 when above):
+    // projecting it onto that plane moves it by this along n.
+    const double below = glm::dot(glm::dvec3(triangle[i]) - position, n);
+    if (below > 0.0) lift += b[i] * below * n;
+  }
+  return lift;
+}
+
+bool liftedRayCrossesItsTriangle(const FloatTriangle& triangle, const glm::dvec3& position,
+                                 const glm::dvec3& lift, const glm::dvec3& direction) {
+  const glm::dvec3 p0(triangle[0]), e1 = glm::dvec3(triangle[1]) - p0, e2 = glm::dvec3(triangle[2]) - p0;
+  const glm::dvec3 n = glm::cross(e1, e2);
+  const double cosine = glm::dot(n, direction);
+  if (cosine == 0.0) return false;  // parallel: never reaches the plane
+  const glm::dvec3 o = position + lift;
+  const double t = glm::dot(p0 - o, n) / cosine;
+  if (!(t > 0.0)) return false;
+  // Barycentrics of the crossing (Cramer's rule in the plane).
+  const glm::dvec3 q = o + t * direction - p0;
+  const double nn = glm::dot(n, n);
+  const double u = glm::dot(glm::cross(q, e2), n) / nn, v = glm::dot(glm::cross(e1, q), n) / nn;
+  constexpr double kMargin = 1e-5;
+  return u >= -kMargin && v >= -kMargin && 1.0 - u - v >= -kMargin;
+}
+
 glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
-                              const glm::dvec3& side) {
+                              const glm::dvec3& side, const glm::dvec3& lift) {
   const TriangleMemo& data = triangleData(triangle);
   const Vertices& p = data.p;
   const double normalLength = data.normalLength;
   if (!(normalLength > 0.0) || !std::isfinite(normalLength))
-    return floatUlpsRayOrigin(glm::vec3(position), glm::vec3(side));  // no plane to leave
-  const double s = glm::dot(side, data.normal) >= 0.0 ? 1.0 : -1.0;   // sideSign(p, side)
+    return floatUlpsRayOrigin(glm::vec3(position + lift), glm::vec3(side));  // no plane to leave
+  const double s = glm::dot(side, data.normal) >= 0.0 ? 1.0 : -1.0;          // sideSign(p, side)
 
   // 1. How far the double hit point may lie off the plane (header).
   const double b0 = 1.0 - double(b1) - double(b2);
@@ -236,11 +268,12 @@ glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& p
   const double dPos = glm::dot(glm::abs(side), pError);
 
   // 2. Embree's bound, estimated at the hit point, as a height.
-  const double dEmbree = std::max(margin(p, position, s, normalLength).bound / normalLength, kMinHeight);
+  const glm::dvec3 lifted = position + lift;
+  const double dEmbree = std::max(margin(p, lifted, s, normalLength).bound / normalLength, kMinHeight);
 
   // 3. Round, then check the float origin and move axis m outward until
   // it passes: the estimate above is only the starting point.
-  const glm::dvec3 q = position + (dPos + dEmbree) * side;
+  const glm::dvec3 q = lifted + (dPos + dEmbree) * side;
   const int m = compensatingAxis(q, side);
   // The others to nearest; whatever height their rounding gained or lost
   // (Σ (o_k − q_k)·n_k), axis m gives back or takes, then rounds outward.
@@ -269,6 +302,70 @@ glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& p
     // Slivers: the bound grows as the origin moves; overshoot after a few
     // tries instead of creeping.
     if (i >= 4) growth *= 2.0;
+  }
+  return o;
+}
+
+double seamTolerance(const FloatTriangle& own, const glm::dvec3& position, const glm::vec3& o) {
+  const glm::dvec3 p0(own[0]);
+  const double edges = glm::length(glm::dvec3(own[1]) - p0) + glm::length(glm::dvec3(own[2]) - p0);
+  const glm::dvec3 a = glm::abs(position);
+  return 0x1p-22 * edges + glm::length(glm::dvec3(o) - position) + 0x1p-45 * (a.x + a.y + a.z);
+}
+
+double planeDistance(const FloatTriangle& triangle, const glm::dvec3& point) {
+  const glm::dvec3 p0(triangle[0]);
+  const glm::dvec3 n = glm::cross(glm::dvec3(triangle[1]) - p0, glm::dvec3(triangle[2]) - p0);
+  const double length = glm::length(n);
+  if (!(length > 0.0)) return kInf;
+  return std::abs(glm::dot(point - p0, n)) / length;
+}
+
+glm::dvec3 seamSide(const FloatTriangle& own, const FloatTriangle& other, const glm::dvec3& direction) {
+  const glm::dvec3 p0(other[0]);
+  const glm::dvec3 n = glm::normalize(glm::cross(glm::dvec3(other[1]) - p0, glm::dvec3(other[2]) - p0));
+  double farthest = 0.0;
+  for (const glm::vec3& v : own) {
+    const double h = glm::dot(glm::dvec3(v) - p0, n);
+    if (std::abs(h) > std::abs(farthest)) farthest = h;
+  }
+  // Coplanar within the plane's own rounding: the side the ray goes to.
+  const glm::dvec3 a = glm::abs(p0);
+  if (std::abs(farthest) <= 0x1p-40 * (1.0 + a.x + a.y + a.z)) farthest = glm::dot(direction, n);
+  return farthest >= 0.0 ? n : -n;
+}
+
+glm::vec3 offsetOffPlanes(const FloatTriangle* triangles, const glm::dvec3* sides, size_t count,
+                          glm::vec3 o) {
+  glm::dvec3 sum(0.0);
+  for (size_t i = 0; i < count; ++i) sum += sides[i];
+  if (!(glm::length(sum) > 0.0)) return o;
+  const glm::dvec3 u = glm::normalize(sum);
+  double growth = 1.0;
+  for (int iteration = 0; iteration < 64; ++iteration) {
+    // The largest height still missing over the planes, along u.
+    double step = 0.0;
+    for (size_t i = 0; i < count; ++i) {
+      const EmbreeSideMargin m = embreeSideMargin(triangles[i], o, sides[i]);
+      if (certified(m)) continue;
+      const double along = glm::dot(u, sides[i]);
+      if (!(along > 0.0)) return o;  // no direction leaves them all
+      const double deficit = std::max(m.bound - m.volume, kMinHeight * m.normalLength - m.volume);
+      step = std::max(step, deficit / m.normalLength / along);
+    }
+    if (step == 0.0) break;
+    step *= growth * (1.0 + 0x1p-20);
+    for (int k = 0; k < 3; ++k) {
+      if (u[k] == 0.0) continue;
+      const float next = roundOutward(double(o[k]) + step * u[k], u[k]);
+      o[k] = next != o[k]
+                 ? next
+                 : roundOutward(
+                       double(std::nextafter(o[k], u[k] > 0.0 ? std::numeric_limits<float>::infinity()
+                                                              : -std::numeric_limits<float>::infinity())),
+                       u[k]);
+    }
+    if (iteration >= 4) growth *= 2.0;
   }
   return o;
 }

@@ -71,6 +71,23 @@
 //
 // Side: the caller passes the unit normal of the side the new ray leaves
 // on (offsetSideNormal()).
+//
+// The shadow terminator (RayOptions::terminator, --terminator): on a
+// low-poly mesh with interpolated normals, a point near the light's
+// terminator is shaded as lit (shading normal towards the light) while its
+// flat triangle faces away, so a ray leaving it runs into the mesh: the
+// facets show as a jagged shadow edge. terminatorLift() moves the point off
+// the flat triangle towards the smooth surface the normals describe, after
+// Hanika, "Hacking the Shadow Terminator" (Ray Tracing Gems II, 2021, ch.
+// 4): the point projected onto the tangent plane of each vertex (only where
+// it lies below that plane), blended with the barycentrics. The lift is
+// applied BEFORE step 3 above, so the float origin is still rounded and
+// checked against Embree's bound for the triangle's plane: it only adds
+// height, never removes the guarantee. What it moves: nothing on flat
+// meshes (vertex normal = face normal gives a zero lift) nor on concave
+// ones (the tangent planes then lie below the triangle); on convex ones at
+// most max_i dot(p_i − P, n_i) ≤ edge length · sin(angle between a vertex
+// normal and the face), e.g. 0.0086·r on a 24×16 UV sphere of radius r.
 #pragma once
 
 #include <array>
@@ -88,8 +105,32 @@ using FloatTriangle = std::array<glm::vec3, 3>;
 // ErrorBound: the origin of a ray leaving `position` (SurfacePoint::position,
 // rebuilt from barycentrics (b1, b2) over `triangle`) on the side of unit
 // normal `side`.
+// `lift` (default none): a displacement of the point off the plane, on the
+// side `side` points to (terminatorLift()); the origin is then checked at
+// position + lift, as without it.
 glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
-                              const glm::dvec3& side);
+                              const glm::dvec3& side, const glm::dvec3& lift = glm::dvec3(0.0));
+
+// The unit vertex normals of one triangle, in stored order.
+using VertexNormals = std::array<glm::vec3, 3>;
+
+// Hanika's point on the smooth surface, as a displacement from `position`
+// (b0·p0 + b1·p1 + b2·p2): Σ_i b_i · max(0, dot(p_i − P, s·n_i)) · s·n_i,
+// with s = ±1 the side of the normals the ray leaves on (−1: a ray into
+// the surface, e.g. refraction, lifted towards the back's tangent planes).
+// Barycentrics are clamped to [0, 1]. In double from the float inputs:
+// relative error ~1e-15 of the lift, which is itself 0 or positive along
+// each s·n_i. Zero when every vertex normal is the face normal.
+glm::dvec3 terminatorLift(const FloatTriangle& triangle, const VertexNormals& normals,
+                          const glm::dvec3& position, double b1, double b2, double s);
+
+// Whether a ray from position + lift along `direction`, where the lift is
+// on the side of unit normal `liftSide` and the direction leaves through
+// the other side, crosses the triangle's own plane inside the triangle
+// (with a margin of 1e-5 in barycentrics): it would hit its own surface
+// again, so the lift cannot be used for it.
+bool liftedRayCrossesItsTriangle(const FloatTriangle& triangle, const glm::dvec3& position,
+                                 const glm::dvec3& lift, const glm::dvec3& direction);
 
 // Step 2 of the header for an origin `o` as Embree reads it (components
 // below FLT_MIN are zero under DAZ): the side volume G = s·dot(o − p0, N)
@@ -112,6 +153,44 @@ bool leavesWithoutRehit(const FloatTriangle& triangle, const glm::vec3& o, const
 // `direction` cannot hit the triangle again.
 bool denominatorCertified(const FloatTriangle& triangle, const glm::vec3& o, const glm::dvec3& side,
                           const glm::vec3& direction);
+
+// Concave seams. At a seam between two surfaces (a floor meeting a wall,
+// a box standing on a floor) the hit point P lies on BOTH planes: on its
+// own triangle T, and within its error on the neighbour N. The offset
+// above lifts the origin off T's plane only, so it starts on N's plane or,
+// by rounding, just behind it, and a ray leaving towards the room crosses
+// N at t ≈ 0: a shadow ray is blocked by the wall it is leaving, and the
+// seam shows as a dark 1-pixel line. In exact arithmetic a ray from a
+// point on a plane meets that plane only at t = 0, so such a hit says
+// nothing about occlusion: what decides is the side. Points of T near the
+// seam lie on one side of N (seamSide); a ray going to that side leaves N
+// and is not blocked by it, one going to the other side is (the light is
+// behind N). The caster asks for the first hit of a blocked shadow ray (a
+// radiance ray has it already); when it is such a seam neighbour, the
+// origin moves off N's plane as well (offsetOffPlanes, the same certified
+// margin as step 2) and the ray is traced again, up to three planes (a
+// corner).
+
+// How far from P a plane through P may pass and still be P's seam
+// neighbour: the in-plane error of P (float barycentrics: 2⁻²⁴ of each
+// edge, ×4 for margin) plus how far the origin `o` already moved from P,
+// plus the double evaluation of a plane at coordinates of magnitude |P|.
+double seamTolerance(const FloatTriangle& own, const glm::dvec3& position, const glm::vec3& o);
+
+// The distance of `point` from the plane of `triangle`, in double (+inf
+// when degenerate).
+double planeDistance(const FloatTriangle& triangle, const glm::dvec3& point);
+
+// The unit normal of the side of `other`'s plane that triangle `own` lies
+// on (its vertex farthest from the plane decides); when `own` lies in that
+// plane (coplanar neighbours), the side `direction` goes to.
+glm::dvec3 seamSide(const FloatTriangle& own, const FloatTriangle& other, const glm::dvec3& direction);
+
+// Moves float origin `o` along the sum of `sides` until every
+// (triangles[i], sides[i]) pair is certified by leavesWithoutRehit; `o`
+// unchanged when it already is, or when the sides admit no common
+// direction.
+glm::vec3 offsetOffPlanes(const FloatTriangle* triangles, const glm::dvec3* sides, size_t count, glm::vec3 o);
 
 struct RayOffsetConstants {
   static constexpr float kOrigin = 1.0f / 32.0f;         // below this |p|: fixed offset

@@ -43,14 +43,15 @@ const fmt = (x) => String(Number(x.toPrecision(9)));
 
 // ---- which options apply (mirrors RenderSettings::applies) ----------------
 function shadowMode(kind, all) {
-  if (kind === 'raytrace' || (kind === 'hybrid' && all)) return 'rays';
   const given = state.options.shadows;
+  if (kind === 'raytrace' || (kind === 'hybrid' && all)) return given === 'none' ? 'none' : 'rays';
   if (all) return given && given !== 'rays' ? given : 'map';
   return given || (kind === 'raster' ? 'map' : 'rays');
 }
 
 function shadowsValid(value, kind) {
   if (value === 'rays') return kind !== 'raster';
+  if (value === 'none') return true;
   return kind !== 'raytrace';
 }
 

@@ -105,6 +105,8 @@ constexpr Choice<RenderOrigin> kOrigins[] = {{"camera", RenderOrigin::Camera},
                                              {"world", RenderOrigin::World}};
 constexpr Choice<RayOffsetMethod> kRayOffsets[] = {{"error-bound", RayOffsetMethod::ErrorBound},
                                                    {"float-ulps", RayOffsetMethod::FloatUlps}};
+constexpr Choice<ShadowTerminator> kTerminators[] = {{"shading-normal", ShadowTerminator::ShadingNormal},
+                                                      {"none", ShadowTerminator::None}};
 constexpr Choice<CullMode> kCullModes[] = {
     {"none", CullMode::None}, {"back", CullMode::Back}, {"front", CullMode::Front}};
 constexpr Choice<ShadowMode> kShadowModes[] = {
@@ -272,7 +274,7 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
      "back", RASTRAY_PARSE(s.raster.cull = pick("--cull", v[0], kCullModes)),
      RASTRAY_FORMAT(return {nameOf(s.raster.cull, kCullModes)})},
     {"--shadows", kAllRenderers, OptionCondition::Always,
-     "map (shadow maps: raster, hybrid), rays (raytrace, hybrid) or none (raster, hybrid); default map, "
+     "map (shadow maps: raster, hybrid), rays (raytrace, hybrid) or none (every renderer); default map, "
      "rays for raytrace and hybrid",
      1, "", RASTRAY_PARSE(s.shadows = pick("--shadows", v[0], kShadowModes)),
      RASTRAY_FORMAT(if (!s.shadows) return {}; return {nameOf(*s.shadows, kShadowModes)})},
@@ -327,6 +329,11 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
      "ch. 6): where secondary and shadow rays start",
      1, "float-ulps", RASTRAY_PARSE(s.ray.offset = pick("--ray-offset", v[0], kRayOffsets)),
      RASTRAY_FORMAT(return {nameOf(s.ray.offset, kRayOffsets)})},
+    {"--terminator", kTraced, OptionCondition::Always,
+     "shading-normal (lift ray origins towards the smooth surface the vertex normals describe, Hanika "
+     "2021) or none (start on the flat triangle: low-poly smooth meshes show facets in shadow edges)",
+     1, "none", RASTRAY_PARSE(s.ray.terminator = pick("--terminator", v[0], kTerminators)),
+     RASTRAY_FORMAT(return {nameOf(s.ray.terminator, kTerminators)})},
     // Traced primary rays.
     {"--no-packets", kRaytrace, OptionCondition::Always,
      "Trace primary rays one by one instead of in coherent packets", 0, "",
@@ -491,8 +498,9 @@ std::string renderOptionsMarkdown() {
 }
 
 ShadowMode RenderSettings::shadowModeFor(RendererKind kind) const {
-  if (kind == RendererKind::Raytrace) return ShadowMode::Rays;
-  if (kind == RendererKind::Hybrid && allRenderers) return ShadowMode::Rays;
+  const ShadowMode traced = ray.shadows ? ShadowMode::Rays : ShadowMode::None;
+  if (kind == RendererKind::Raytrace) return traced;
+  if (kind == RendererKind::Hybrid && allRenderers) return traced;
   return raster.shadows;
 }
 
@@ -514,19 +522,23 @@ void RenderSettings::finish() {
     badOption("--spp", std::to_string(spp) + " is not supported (use " + supportedSampleCounts() + ")");
   if (!isGiven("--max-memory")) memory = MemoryBudget::machineDefault();
 
-  // Shadows: map and none need the rasterizer, rays a ray tracer (the ray
-  // caster traces shadow rays always). raster.shadows is the rasterizer's
+  // Shadows: map needs the rasterizer, rays a ray tracer, none applies to
+  // every renderer (the ray caster then traces no shadow rays, nor does
+  // hybrid for its secondary hits). raster.shadows is the rasterizer's
   // technique; with allRenderers, that of the rasterizer alone.
   const RendererKind rasterizing = allRenderers ? RendererKind::Raster : renderer;
   const ShadowMode shadowMode = shadows                               ? *shadows
                                 : rasterizing == RendererKind::Raster ? ShadowMode::Map
                                                                       : ShadowMode::Rays;
-  const RendererSet shadowModeRenderers = shadowMode == ShadowMode::Rays ? kTraced : kRasterized;
+  const RendererSet shadowModeRenderers = shadowMode == ShadowMode::Rays   ? kTraced
+                                          : shadowMode == ShadowMode::None ? kAllRenderers
+                                                                           : kRasterized;
   if (!allRenderers && !(shadowModeRenderers & rendererBit(renderer)))
     badOption("--shadows", "'" + nameOf(shadowMode, kShadowModes) + "' applies to " +
                                describeRenderers(shadowModeRenderers) + ", not to --renderer " +
                                toString(renderer));
   raster.shadows = allRenderers && shadowMode == ShadowMode::Rays ? ShadowMode::Map : shadowMode;
+  ray.shadows = shadowMode != ShadowMode::None;
 
   raster.spp = spp;
   raster.shading = shading;

@@ -280,7 +280,9 @@ std::vector<Cell> planCells(const SweepSpec& spec) {
     for (size_t i = 0; i < groups.size(); ++i) {
       const OptionGroup& g = groups[i];
       if (g.name == "--shadows") {
-        const RendererSet where = g.values[0] == "rays" ? traced : rasterized;
+        const RendererSet where = g.values[0] == "rays"   ? traced
+                                  : g.values[0] == "none" ? kAllRenderers
+                                                          : rasterized;
         applies[i] = (where & rendererBit(kind)) != 0;
         if (applies[i]) appendGroup(base, g);
       } else if (g.name == "--wireframe") {

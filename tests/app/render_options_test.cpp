@@ -74,6 +74,7 @@ const std::vector<Expected> kExpected = {
     {"--no-refraction", kRaytrace | kHybrid, OptionCondition::Always, {}},
     {"--transparency-cutoff", kRaytrace | kHybrid, OptionCondition::Always, {"0.01"}},
     {"--ray-offset", kRaytrace | kHybrid, OptionCondition::Always, {"float-ulps"}},
+    {"--terminator", kRaytrace | kHybrid, OptionCondition::Always, {"none"}},
     {"--no-packets", kRaytrace, OptionCondition::Always, {}},
 };
 
@@ -235,10 +236,13 @@ TEST(RenderOptions, ShadowTechniquesPerRenderer) {
   };
   for (const Case& c :
        {Case{"raster", "map", true}, Case{"raster", "none", true}, Case{"raster", "rays", false},
-        Case{"raytrace", "rays", true}, Case{"raytrace", "map", false}, Case{"raytrace", "none", false},
+        Case{"raytrace", "rays", true}, Case{"raytrace", "map", false}, Case{"raytrace", "none", true},
         Case{"hybrid", "map", true}, Case{"hybrid", "none", true}, Case{"hybrid", "rays", true}}) {
-    const auto error = finishWith({"--renderer", c.renderer, "--shadows", c.shadows});
+    RenderSettings s;
+    const auto error = finishWith({"--renderer", c.renderer, "--shadows", c.shadows}, true, &s);
     EXPECT_EQ(!error, c.accepted) << c.renderer << " " << c.shadows;
+    // none reaches the ray caster too (hybrid's secondary hits, raytrace's every hit).
+    if (!error) EXPECT_EQ(s.ray.shadows, std::string(c.shadows) != "none") << c.renderer << " " << c.shadows;
     if (error) {
       EXPECT_EQ(error->element(), "--shadows");
     }
@@ -261,6 +265,9 @@ TEST(RenderOptions, AllRenderersAcceptWhatAppliesToOne) {
   EXPECT_FALSE(s.ray.packets);
   ASSERT_FALSE(finishWith({"--shadows", "none"}, false, &s));
   EXPECT_EQ(s.raster.shadows, ShadowMode::None);
+  EXPECT_FALSE(s.ray.shadows);  // crossval: no renderer shadows
+  EXPECT_EQ(s.shadowModeFor(RendererKind::Raytrace), ShadowMode::None);
+  EXPECT_EQ(s.shadowModeFor(RendererKind::Hybrid), ShadowMode::None);
 
   // Refused only when it applies to none of them.
   auto error = finishWith({"--shadows", "none", "--shadow-map-size", "64"}, false);
