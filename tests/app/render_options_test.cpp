@@ -242,7 +242,9 @@ TEST(RenderOptions, ShadowTechniquesPerRenderer) {
     const auto error = finishWith({"--renderer", c.renderer, "--shadows", c.shadows}, true, &s);
     EXPECT_EQ(!error, c.accepted) << c.renderer << " " << c.shadows;
     // none reaches the ray caster too (hybrid's secondary hits, raytrace's every hit).
-    if (!error) EXPECT_EQ(s.ray.shadows, std::string(c.shadows) != "none") << c.renderer << " " << c.shadows;
+    if (!error) {
+      EXPECT_EQ(s.ray.shadows, std::string(c.shadows) != "none") << c.renderer << " " << c.shadows;
+    }
     if (error) {
       EXPECT_EQ(error->element(), "--shadows");
     }
