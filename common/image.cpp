@@ -121,6 +121,10 @@ void writeDeepExr(const std::string& path, const DeepImage& image) {
 
 bool isDeepExr(const std::string& path, uint64_t maxBytes) { return oiioModule().isDeepExr(path, maxBytes); }
 
+std::string exrChannelType(const std::string& path, const std::string& channel) {
+  return oiioModule().exrChannelType(path, channel);
+}
+
 namespace {
 
 // input, not a crash.

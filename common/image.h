@@ -133,6 +133,10 @@ DeepImage readDeepExr(const std::string& path, uint64_t maxBytes = kNoReadLimit)
 // Throws InputError like the readers when the file cannot be opened as EXR
 // (or its data window alone needs more than maxBytes to open).
 bool isDeepExr(const std::string& path, uint64_t maxBytes = kNoReadLimit);
+// The type an EXR file stores `channel` in, as OpenImageIO names it
+// ("half", "float", "uint"); "" when the file has no such channel. Opens
+// the file as the readers do (same checks, same InputErrors).
+std::string exrChannelType(const std::string& path, const std::string& channel);
 
 // Writes a text file (HTML, CSV, JSON) the same atomic way as images.
 // Throws InputError (file: path) when it cannot.

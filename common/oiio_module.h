@@ -46,6 +46,7 @@ struct OiioFunctions {
                    ColorPrecision precision);
   void (*writeDeepExr)(const std::string& path, const std::string& tmpPath, const DeepImage& image);
   bool (*isDeepExr)(const std::string& path, uint64_t maxBytes);
+  std::string (*exrChannelType)(const std::string& path, const std::string& channel);
   FlatImage (*readExr)(const std::string& path, uint64_t maxBytes);
   DeepImage (*readDeepExr)(const std::string& path, uint64_t maxBytes);
   // Box-filtered resize of packed RGBA float images (ImageBufAlgo::resize "box").
@@ -69,7 +70,7 @@ struct OiioHost {
   std::string (*formatBytes)(uint64_t bytes);
 };
 
-constexpr int kOiioModuleVersion = 1;
+constexpr int kOiioModuleVersion = 2;
 
 // Loads the module on the first call (thread-safe) and returns its
 // functions. Looks beside the running program, one folder up (test,

@@ -7,7 +7,6 @@
 #include <memory>
 #include <set>
 
-#include <OpenImageIO/imageio.h>
 #include <tbb/global_control.h>
 
 #include "app/crossval/crossval.h"
@@ -439,15 +438,9 @@ double stageSeconds(const RenderRun& run, const std::string& stage) {
 namespace {
 
 // Whether the file's R channel is stored as half: rounded colours no
-// render's float colours equal.
-bool halfColor(const std::string& path) {
-  const auto in = OIIO::ImageInput::open(path);
-  if (!in) return false;
-  const OIIO::ImageSpec& spec = in->spec();
-  for (int c = 0; c < spec.nchannels; ++c)
-    if (spec.channelnames[size_t(c)] == "R") return spec.channelformat(c) == OIIO::TypeDesc::HALF;
-  return false;
-}
+// render's float colours equal. (Through common/image.h, which opens the
+// file as the reader just did: OpenEXR only, after the header checks.)
+bool halfColor(const std::string& path) { return exrChannelType(path, "R") == "half"; }
 
 }  // namespace
 

@@ -15,6 +15,7 @@ void writeExr(const std::string& path, const std::string& tmp, const FlatImage& 
               ColorPrecision precision);
 void writeDeepExr(const std::string& path, const std::string& tmp, const DeepImage& image);
 bool isDeepExr(const std::string& path, uint64_t maxBytes);
+std::string exrChannelType(const std::string& path, const std::string& channel);
 FlatImage readExr(const std::string& path, uint64_t maxBytes);
 DeepImage readDeepExr(const std::string& path, uint64_t maxBytes);
 
