@@ -363,7 +363,8 @@ void writeDeepExr(const std::string& path, const std::string& tmp, const DeepIma
 bool isDeepExr(const std::string& path, uint64_t maxBytes) { return openExr(path, maxBytes)->spec().deep; }
 
 std::string exrChannelType(const std::string& path, const std::string& channel) {
-  const OIIO::ImageSpec& spec = openExr(path, kNoReadLimit)->spec();
+  const std::unique_ptr<OIIO::ImageInput> in = openExr(path, kNoReadLimit);  // owns the spec
+  const OIIO::ImageSpec& spec = in->spec();
   const int c = spec.channelindex(channel);
   return c < 0 ? std::string() : std::string(spec.channelformat(c).c_str());
 }

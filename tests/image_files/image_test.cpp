@@ -181,6 +181,23 @@ TEST_F(ImageTest, PngIsStraightSrgbRoundedToNearest) {
   EXPECT_EQ(entries(), std::vector<std::string>{"out.png"});
 }
 
+// exrChannelType reads a channel's stored type through the module's
+// checked EXR opening (sweep --reference asks it of R). Its first version
+// read the type from a spec whose ImageInput was already gone.
+TEST_F(ImageTest, ExrChannelTypeNamesEachChannelsStoredType) {
+  const std::string half = path("half.exr"), full = path("float.exr");
+  writeImage(half, testImage(), ColorPrecision::Half);
+  writeImage(full, testImage(), ColorPrecision::Float);
+  for (const auto& [file, color] : {std::pair{half, "half"}, std::pair{full, "float"}}) {
+    for (const char* c : {"R", "G", "B", "A"})
+      EXPECT_EQ(exrChannelType(file, c), color) << file << " " << c;
+    EXPECT_EQ(exrChannelType(file, "Z"), "float");
+    EXPECT_EQ(exrChannelType(file, "id.instance"), "uint");
+    EXPECT_EQ(exrChannelType(file, "Y"), "");
+  }
+  EXPECT_THROW(exrChannelType(path("missing.exr"), "R"), InputError);
+}
+
 TEST_F(ImageTest, ExrRoundTripsEveryChannelExactlyInFloat) {
   const FlatImage image = testImage();
   const std::string file = path("flat.exr");
