@@ -14,6 +14,7 @@ packages=(
   chromium  # the real-browser tests (crossval report, `rastray serve` page, headless), which CI must run, not skip
   libhwy-dev  # Highway: portable SIMD with run-time dispatch (shading, resolve, PNG encoding)
   libcpp-httplib-dev  # the HTTP server of `rastray serve`, the browser explorer
+  curl  # the serve examples of docs/SERVE.md and README.md, run by tests/docs
   nodejs  # bench/explorer_previews.sh drives headless Chromium over the DevTools protocol
   libosmesa6-dev embree-tools  # performance peers of `rastray bench --peers`: Mesa llvmpipe, Embree's viewer
   assimp-testmodels  # real-world glTF models: the CAD-like 2CylinderEngine.glb that `rastray bench` measures
