@@ -19,6 +19,9 @@ packages=(
   libosmesa6-dev embree-tools  # performance peers of `rastray bench --peers`: Mesa llvmpipe, Embree's viewer
   assimp-testmodels  # real-world glTF models: the CAD-like 2CylinderEngine.glb that `rastray bench` measures
   clang libfuzzer-14-dev libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer targets (fuzz/, -DRASTRAY_FUZZ=ON) need clang
+  libdraco-dev draco libmeshoptimizer-dev gltfpack  # compressed glTF: Draco and meshopt decoders; encoders make the test files
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib  # the Python module (python/) and its tests
+  povray  # an independent Whitted ray tracer: the shadow-mask comparison (docs/SHADOWS.md)
 )
 
 missing=()

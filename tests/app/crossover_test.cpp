@@ -206,13 +206,18 @@ TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
   EXPECT_NE(slurp(dir / "index.html").find("<svg"), std::string::npos);
 
   // Peak memory grows with the triangle count, for each renderer and size.
+  // The floor is what 200,000 triangles must hold at the least: 2.4 MB of
+  // indices and 1.2 MB of positions, with the glTF buffer they were read
+  // from. The raster visibility cell grows by only about 8 MB in all (no
+  // BVH, no shading data), so a margin of 8 MiB failed on some machines.
+  constexpr uint64_t kLeastGrowth = 4u << 20;
   for (const CellResult& small : rows)
     for (const CellResult& large : rows)
       if (small.triangles == 100 && large.triangles == 200'000 && small.renderer == large.renderer &&
           small.width == large.width) {
-        EXPECT_GT(large.visibilityPeakRssBytes, small.visibilityPeakRssBytes + (8u << 20))
+        EXPECT_GT(large.visibilityPeakRssBytes, small.visibilityPeakRssBytes + kLeastGrowth)
             << small.renderer << " " << small.width << "x" << small.height;
-        EXPECT_GT(large.shadedPeakRssBytes, small.shadedPeakRssBytes + (8u << 20))
+        EXPECT_GT(large.shadedPeakRssBytes, small.shadedPeakRssBytes + kLeastGrowth)
             << small.renderer << " " << small.width << "x" << small.height;
       }
 }
