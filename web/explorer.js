@@ -6,7 +6,6 @@
 'use strict';
 
 const $ = (id) => document.getElementById(id);
-const ALL = ['raster', 'raytrace', 'hybrid'];
 
 const state = {
   scene: '',
@@ -21,6 +20,7 @@ const state = {
   sceneInfo: null,
 };
 let optionTable = [];
+let applicability = [];
 const client = Math.random().toString(36).slice(2, 10);
 let seq = 0;
 let lastFrame = null; // the last final frame shown: {width, height}
@@ -41,32 +41,32 @@ function rotate(v, axis, angle) {
 // Numbers as the command line shows them: 9 significant digits, no noise.
 const fmt = (x) => String(Number(x.toPrecision(9)));
 
-// ---- which options apply (mirrors RenderSettings::applies) ----------------
-function shadowMode(kind, all) {
-  const given = state.options.shadows;
-  if (kind === 'raytrace' || (kind === 'hybrid' && all)) return given === 'none' ? 'none' : 'rays';
-  if (all) return given && given !== 'rays' ? given : 'map';
-  return given || (kind === 'raster' ? 'map' : 'rays');
-}
-
-function shadowsValid(value, kind) {
-  if (value === 'rays') return kind !== 'raster';
-  if (value === 'none') return true;
-  return kind !== 'raytrace';
+// ---- which options apply ------------------------------------------------------
+// The server's answer (/api/options "applicability", from
+// RenderSettings::applies) for each renderer, or 'all', under each --shadows
+// value and wireframe setting: the page keeps no copy of the rules.
+function applicabilityEntry(target, shadows) {
+  const wireframe = state.options.wireframe === 'on';
+  return applicability.find((a) => a.renderer === target && a.shadows === (shadows || '') &&
+    a.wireframe === wireframe);
 }
 
 function applies(opt, all, renderer) {
-  const kinds = all ? ALL : [renderer];
-  return kinds.some((k) => opt.renderers.includes(k) &&
-    (opt.condition === 'always' ||
-     (opt.condition === 'shadow-maps' && shadowMode(k, all) === 'map') ||
-     (opt.condition === 'wireframe' && state.options.wireframe === 'on')));
+  const entry = applicabilityEntry(all ? 'all' : renderer, state.options.shadows);
+  return !!entry && entry.applies.includes(opt.name);
+}
+
+// Whether `renderer` (or, with all, the views running every renderer) takes
+// --shadows `value`.
+function shadowsValid(value, renderer, all) {
+  const entry = applicabilityEntry(all ? 'all' : renderer, value);
+  return !!entry && entry.valid;
 }
 
 function optionApplies(name, all, renderer) {
   const opt = optionTable.find((o) => o.name === name);
   if (!opt || !applies(opt, all, renderer)) return false;
-  if (name === 'shadows' && !all) return shadowsValid(state.options.shadows, renderer);
+  if (name === 'shadows') return shadowsValid(state.options.shadows, renderer, all);
   return true;
 }
 
@@ -547,7 +547,7 @@ function updateApplicability() {
     c.closest('label').title = info ? info.help + (ok ? '' : ' (applies to ' + info.applies + ')') : '';
   }
   for (const opt of document.querySelectorAll('[data-option="shadows"] option')) {
-    opt.disabled = !all && opt.value !== '' && !renderers.every((r) => shadowsValid(opt.value, r));
+    opt.disabled = opt.value !== '' && !renderers.every((r) => shadowsValid(opt.value, r, all));
   }
   $('peel-layers').hidden = state.options.transparency === undefined || !state.options.transparency.startsWith('peel');
   $('renderer-label').hidden = all;
@@ -796,6 +796,7 @@ async function init() {
   try {
     const [opts, scenes] = await Promise.all([getJson('/api/options'), getJson('/api/scenes')]);
     optionTable = opts.options;
+    applicability = opts.applicability;
     const spp = document.querySelector('[data-option="spp"]');
     for (const n of opts.sppValues) spp.append(new Option(String(n), String(n)));
     for (const s of scenes.scenes) $('scene').append(new Option(s, s));

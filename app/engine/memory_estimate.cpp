@@ -6,25 +6,17 @@
 #include <tbb/info.h>
 
 #include "common/parallel.h"
-#include "raster/bin.h"
-#include "raster/setup.h"
-#include "raster/tile_renderer.h"
+#include "raster/memory_estimate.h"
+#include "raytrace/memory_estimate.h"
 
 namespace rastray {
 
 namespace {
 
-// Sizes of what the renderers allocate per unit, in bytes. Where a
-// structure is private to a renderer the figure is measured (peak RSS per
-// unit on scenes of 10^5–10^6 triangles) and rounded up.
+// Sizes of the outputs and files, in bytes; each renderer sizes its own
+// structures (raster/memory_estimate.h, raytrace/memory_estimate.h).
 constexpr uint64_t kFlatPixelBytes = sizeof(glm::vec4) + sizeof(float) + 2 * sizeof(uint32_t);
-constexpr uint64_t kDepthTargetSampleBytes = 2 * sizeof(uint32_t);  // key + winner
-constexpr uint64_t kShadowTexelBytes = sizeof(uint32_t);            // keys only
-// Deep samples are gathered per tile (rasterizer) or per tile and thread
-// (ray caster; measured 48 bytes per entry) and then assembled into one
-// DeepImage: gathered and assembled copies exist at once.
 constexpr uint64_t kDeepEntryBytes = sizeof(DeepSample);
-constexpr uint64_t kDeepGatherBytes[2] = {sizeof(DeepSample), 48};  // raster, ray caster
 // Writing a deep EXR: OIIO's DeepData holds a second copy of the samples
 // (9 channels of 4 bytes), and it and OpenEXR keep per-pixel counts and
 // per-channel pointers (measured: about 140 bytes per pixel).
@@ -34,11 +26,6 @@ constexpr uint64_t kDeepWritePixelBytes = 140;
 // Z, two ids; PNG: RGBA8 and row pointers).
 constexpr uint64_t kExrWritePixelBytes = 28;
 constexpr uint64_t kPngWritePixelBytes = 8;
-// A triangle is binned into every tile its box touches: a few on average.
-constexpr uint64_t kBinBytesPerTriangle = 4 * sizeof(uint32_t);
-// Embree's BVH over triangles with the geometry buffers it shares
-// (measured: 50–60 bytes per triangle at build quality medium).
-constexpr uint64_t kBvhBytesPerTriangle = 96;
 // Mip chains of decoded textures: linear float RGBA, 4/3 of the base level.
 constexpr uint64_t kMipTexelBytes = sizeof(glm::vec4) * 4 / 3 + 1;
 
@@ -127,31 +114,6 @@ uint64_t textureTexels(const Scene& scene) {
   return texels;
 }
 
-void addRasterParts(const Scene& scene, const RenderSettings& s, double layers, RenderMemory& m) {
-  const uint64_t triangles = scene.triangleCount();
-  const uint64_t setupBytes = mulSat(triangles, sizeof(TriangleSetup));
-  m.transient.add("triangle setups", setupBytes);
-  // The setup's per-vertex codes, alive while setups are made (raster/setup.h).
-  m.transient.add("setup vertex codes", mulSat(scene.positions.size(), kSetupVertexCodeBytes));
-  m.transient.add("tile bins", mulSat(triangles, kBinBytesPerTriangle));
-  m.transient.add("depth target", mulSat(samplesOf(s), kDepthTargetSampleBytes));
-  if (s.raster.shadows == ShadowMode::Map && !scene.lights.empty()) {
-    // Every face of every light's map stays until the frame ends; one
-    // face's setups and a candidate mask exist while it is drawn.
-    uint64_t faces = 0;
-    for (const Light& light : scene.lights) faces += light.type == LightType::Point ? 6 : 1;
-    const uint64_t texels = uint64_t(s.raster.shadowMapSize) * uint64_t(s.raster.shadowMapSize);
-    m.transient.add("shadow maps", mulSat(mulSat(faces, texels), kShadowTexelBytes));
-    m.transient.add("shadow map setups", addSat(setupBytes, triangles));
-  }
-  if (layers > 0.0) {
-    // Fragments and shaded layers of the tiles in flight, one per thread.
-    const uint64_t tileSamples = uint64_t(kTileSize) * kTileSize * uint64_t(s.spp);
-    const double perTile = double(tileSamples) * layers * double(sizeof(BlendFragment) + sizeof(BlendLayer));
-    m.transient.add("transparency fragments", uint64_t(std::min(perTile * threadsOf(s), 1.8e19)));
-  }
-}
-
 // Resident now + the parts of `frame` + `extra` + slack for what no
 // structure accounts for: thread stacks and arenas, allocator rounding,
 // vectors' spare capacity (32 MiB and 5 % of the rest).
@@ -217,13 +179,15 @@ RenderMemory estimateFrameMemory(const Scene& scene, const RenderSettings& s, Re
       return uint64_t(std::min(m.deepEntries * perEntry, 1.8e19));
     };
     m.kept.add("deep samples", addSat(bytes(kDeepEntryBytes), mulSat(pixelsOf(s), sizeof(uint64_t))));
-    m.transient.add("deep sample gathering", bytes(kDeepGatherBytes[kind == RendererKind::Raytrace]));
+    m.transient.add("deep sample gathering",
+                    bytes(kind == RendererKind::Raytrace ? rayDeepGatherBytesPerSample()
+                                                         : rasterDeepGatherBytesPerSample()));
   }
   const uint64_t texels = textureTexels(scene);
   if (texels > 0) m.kept.add("mip chains", mulSat(texels, kMipTexelBytes));
-  if (kind != RendererKind::Raytrace) addRasterParts(scene, s, layers, m);
-  if (kind != RendererKind::Raster)
-    m.transient.add("Embree BVH", mulSat(scene.triangleCount(), kBvhBytesPerTriangle));
+  if (kind != RendererKind::Raytrace)
+    addRasterFrameMemory(scene, s.raster, samplesOf(s), layers, threadsOf(s), m.transient);
+  if (kind != RendererKind::Raster) addRayFrameMemory(scene, m.transient);
   return m;
 }
 

@@ -106,7 +106,7 @@ constexpr Choice<RenderOrigin> kOrigins[] = {{"camera", RenderOrigin::Camera},
 constexpr Choice<RayOffsetMethod> kRayOffsets[] = {{"error-bound", RayOffsetMethod::ErrorBound},
                                                    {"float-ulps", RayOffsetMethod::FloatUlps}};
 constexpr Choice<ShadowTerminator> kTerminators[] = {{"shading-normal", ShadowTerminator::ShadingNormal},
-                                                      {"none", ShadowTerminator::None}};
+                                                     {"none", ShadowTerminator::None}};
 constexpr Choice<CullMode> kCullModes[] = {
     {"none", CullMode::None}, {"back", CullMode::Back}, {"front", CullMode::Front}};
 constexpr Choice<ShadowMode> kShadowModes[] = {
@@ -416,6 +416,12 @@ std::string helpWithWhere(const RenderOptionSpec& spec) {
 std::string defaultText(const RenderOptionSpec& spec) {
   static const RenderSettings defaults;
   return join(spec.format(defaults));
+}
+
+std::vector<std::string> shadowModeNames() {
+  std::vector<std::string> names;
+  for (const auto& c : kShadowModes) names.push_back(c.name);
+  return names;
 }
 
 std::optional<std::vector<std::string>> splitOptionValue(const std::string& value, int arity) {

@@ -76,6 +76,8 @@ std::string defaultText(const RenderOptionSpec& spec);
 // (the documented form, as `sweep --vary`), "320,240" and "320:240" read
 // the same. Returns `arity` non-empty words, or nullopt.
 std::optional<std::vector<std::string>> splitOptionValue(const std::string& value, int arity);
+// The values --shadows takes ("map", "rays", "none"), as it parses them.
+std::vector<std::string> shadowModeNames();
 
 struct RenderSettings {
   RendererKind renderer = RendererKind::Raster;

@@ -202,6 +202,64 @@ std::string queryDefault(const RenderOptionSpec& spec) {
 
 }  // namespace
 
+namespace {
+
+// Which options apply under each setting of what the table's conditions
+// read (--shadows, --wireframe), per renderer and for all of them at once
+// (the views that run every renderer), decided by RenderSettings::applies:
+// the page looks its answer up rather than re-deriving the rules. A
+// --shadows value a renderer refuses is marked invalid with the command
+// line's message; what applies then is what applies without it, since the
+// page leaves the refused value out of its requests.
+nlohmann::ordered_json applicabilityJson() {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  std::vector<std::string> shadowValues = {""};  // "": not given
+  for (const std::string& v : shadowModeNames()) shadowValues.push_back(v);
+  const std::vector<std::pair<std::string, std::optional<RendererKind>>> targets = {
+      {"raster", RendererKind::Raster},
+      {"raytrace", RendererKind::Raytrace},
+      {"hybrid", RendererKind::Hybrid},
+      {"all", std::nullopt}};
+  for (const auto& [target, kind] : targets)
+    for (const std::string& shadows : shadowValues)
+      for (const bool wireframe : {false, true}) {
+        const auto settings = [&](bool withShadows) {
+          std::vector<std::string> args;
+          if (kind) args = {"--renderer", target};
+          if (withShadows && !shadows.empty()) args.insert(args.end(), {"--shadows", shadows});
+          RenderSettings s = renderSettingsFrom(args, !kind);
+          s.raster.wireframe = wireframe;  // a condition, not an option given
+          return s;
+        };
+        std::string error;
+        RenderSettings s;
+        try {
+          s = settings(true);
+        } catch (const InputError& e) {
+          error = e.what();
+          s = settings(false);
+        }
+        nlohmann::ordered_json applying = nlohmann::ordered_json::array();
+        for (const RenderOptionSpec& spec : renderOptionTable()) {
+          if (serverSets(spec.name)) continue;
+          const bool applies = kind ? s.applies(spec, *kind)
+                                    : s.applies(spec, RendererKind::Raster) ||
+                                          s.applies(spec, RendererKind::Raytrace) ||
+                                          s.applies(spec, RendererKind::Hybrid);
+          if (applies) applying.push_back(std::string(spec.name).substr(2));
+        }
+        out.push_back({{"renderer", target},
+                       {"shadows", shadows},
+                       {"wireframe", wireframe},
+                       {"valid", error.empty()},
+                       {"error", error},
+                       {"applies", applying}});
+      }
+  return out;
+}
+
+}  // namespace
+
 nlohmann::ordered_json optionTableJson() {
   nlohmann::ordered_json options = nlohmann::ordered_json::array();
   for (const RenderOptionSpec& spec : renderOptionTable()) {
@@ -224,7 +282,11 @@ nlohmann::ordered_json optionTableJson() {
   nlohmann::ordered_json spp = nlohmann::ordered_json::array();
   for (int n = 1; n <= 256; ++n)
     if (isSupportedSampleCount(n)) spp.push_back(n);
-  return {{"schema", "rastray.serve.options"}, {"version", 1}, {"options", options}, {"sppValues", spp}};
+  return {{"schema", "rastray.serve.options"},
+          {"version", 1},
+          {"options", options},
+          {"sppValues", spp},
+          {"applicability", applicabilityJson()}};
 }
 
 namespace {

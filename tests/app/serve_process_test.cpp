@@ -153,6 +153,16 @@ TEST(ServeBrowser, PageShowsTheImageAndExplainsAClickedPixel) {
   EXPECT_NE(html.find("class=\"ray ray-shadow"), std::string::npos);
   EXPECT_NE(html.find("rastray render " + scenePath("cornell-box") + " --renderer raytrace --eye "),
             std::string::npos);
+  // What applies to the ray caster, as /api/options' applicability says
+  // (the page keeps no copy of the rules): the map size is greyed out and
+  // disabled, the terminator is not, and --shadows map cannot be chosen.
+  EXPECT_TRUE(std::regex_search(
+      html, std::regex("<label class=\"na\"[^>]*>map size <select data-option=\"shadow-map-size\" disabled")))
+      << html.substr(html.find("map size") - 200, 400);
+  EXPECT_TRUE(
+      std::regex_search(html, std::regex("<label[^>]*>terminator <select data-option=\"terminator\">")));
+  EXPECT_FALSE(std::regex_search(html, std::regex("<label class=\"na\"[^>]*>terminator")));
+  EXPECT_TRUE(std::regex_search(html, std::regex("<option disabled=\"\">map</option><option>rays</option>")));
   EXPECT_EQ(server.stop(SIGTERM), 128 + SIGTERM) << server.err();
   fs::remove_all(dir);
 }

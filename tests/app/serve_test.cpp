@@ -514,6 +514,52 @@ TEST(ServeApi, Base64MatchesRfc4648) {
   EXPECT_EQ(serve::base64(std::string("\xff\x00\x10", 3)), "/wAQ");
 }
 
+// /api/options says, for each renderer (or all) and each setting of what
+// the conditions read, which options apply and whether --shadows' value is
+// taken: the explorer's greying out reads it and keeps no rules of its own.
+TEST(ServeApi, ApplicabilityFollowsTheRendersOwnRules) {
+  const json table = json::parse(serve::optionTableJson().dump());
+  const auto entry = [&](const std::string& renderer, const std::string& shadows, bool wireframe) {
+    for (const json& a : table.at("applicability"))
+      if (a.at("renderer") == renderer && a.at("shadows") == shadows && a.at("wireframe") == wireframe)
+        return a;
+    ADD_FAILURE() << renderer << " " << shadows << " " << wireframe << ": no entry";
+    return json();
+  };
+  const auto applies = [](const json& a, const std::string& name) {
+    for (const json& n : a.at("applies"))
+      if (n == name) return true;
+    return false;
+  };
+  // 4 targets x (default, map, rays, none) x wireframe off/on.
+  EXPECT_EQ(table.at("applicability").size(), 32u);
+  EXPECT_TRUE(applies(entry("raster", "", false), "shadow-map-size"));
+  EXPECT_FALSE(applies(entry("raster", "none", false), "shadow-map-size"));
+  EXPECT_FALSE(applies(entry("raytrace", "", false), "shadow-map-size"));
+  EXPECT_TRUE(applies(entry("raytrace", "", false), "terminator"));
+  EXPECT_TRUE(applies(entry("hybrid", "map", false), "shadow-map-size"));
+  EXPECT_FALSE(applies(entry("hybrid", "", false), "shadow-map-size"));
+  // With every renderer, the rasterizer's map applies unless shadows are off.
+  EXPECT_TRUE(applies(entry("all", "rays", false), "shadow-map-size"));
+  EXPECT_FALSE(applies(entry("all", "none", false), "shadow-map-size"));
+  // --halo needs --wireframe; the ray caster draws none.
+  EXPECT_FALSE(applies(entry("raster", "", false), "halo"));
+  EXPECT_TRUE(applies(entry("raster", "", true), "halo"));
+  EXPECT_FALSE(applies(entry("raytrace", "", true), "halo"));
+  // A refused value carries the command line's message; what applies is
+  // then what applies without it (the page leaves it out).
+  const json refused = entry("raytrace", "map", false);
+  EXPECT_FALSE(refused.at("valid").get<bool>());
+  EXPECT_NE(refused.at("error").get<std::string>().find("'map' applies to raster and hybrid"),
+            std::string::npos)
+      << refused.at("error");
+  EXPECT_EQ(refused.at("applies"), entry("raytrace", "", false).at("applies"));
+  EXPECT_FALSE(entry("raster", "rays", false).at("valid").get<bool>());
+  for (const char* target : {"raster", "raytrace", "hybrid", "all"})
+    EXPECT_TRUE(entry(target, "none", false).at("valid").get<bool>()) << target;
+  EXPECT_TRUE(entry("all", "rays", false).at("valid").get<bool>());
+}
+
 }  // namespace
 }  // namespace rastray
 
