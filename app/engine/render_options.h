@@ -82,6 +82,8 @@ std::vector<std::string> shadowModeNames();
 struct RenderSettings {
   RendererKind renderer = RendererKind::Raster;
   int spp = 1;
+  // --exposure: the output colour is scaled by 2^exposure (FrameRenderer).
+  double exposure = 0.0;
   CameraOptions camera;
   RasterOptions raster;
   RayOptions ray;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iterator>
 
@@ -64,6 +65,7 @@ FrameRenderer::FrameRenderer(const Scene& scene, const RenderSettings& s, const 
                              const RayOptions& ray, std::shared_ptr<RayCaster> sharedCaster)
     : scene_(scene),
       renderer_(s.renderer),
+      exposureScale_(float(std::exp2(s.exposure))),
       raster_(raster),
       ray_(ray),
       analysis_(analyzeScene(scene)),
@@ -81,7 +83,26 @@ FrameRenderer::FrameRenderer(const Scene& scene, const RenderSettings& s, const 
 
 FrameRenderer::~FrameRenderer() = default;
 
+namespace {
+
+// --exposure: premultiplied RGB times `scale`, in the image and in every
+// deep layer (alpha, depth and IDs unchanged), after the renderers, so
+// both renderers and the comparison see the same scaling.
+void applyExposure(RenderOutput& output, float scale) {
+  if (scale == 1.0f) return;
+  for (glm::vec4& c : output.image.color) c = glm::vec4(glm::vec3(c) * scale, c.a);
+  for (DeepSample& d : output.samples.samples) d.color = glm::vec4(glm::vec3(d.color) * scale, d.color.a);
+}
+
+}  // namespace
+
 RenderOutput FrameRenderer::frame() {
+  RenderOutput output = renderFrame();
+  applyExposure(output, exposureScale_);
+  return output;
+}
+
+RenderOutput FrameRenderer::renderFrame() {
   // The caster may be shared (serve) and bound to another frame's camera
   // and options since: bind this frame's (cheap next to a frame).
   if (caster_) caster_->bind(camera_, ray_);

@@ -55,8 +55,11 @@ class FrameRenderer {
   const std::shared_ptr<RayCaster>& caster() const { return caster_; }
 
  private:
+  RenderOutput renderFrame();
+
   const Scene& scene_;
   RendererKind renderer_;
+  float exposureScale_;  // 2^--exposure, exact in float for whole stops
   const RasterOptions& raster_;
   const RayOptions& ray_;
   SceneAnalysis analysis_;

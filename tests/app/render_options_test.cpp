@@ -52,6 +52,7 @@ const std::vector<Expected> kExpected = {
     {"--zfar", kAllRenderers, OptionCondition::Always, {"100"}},
     {"--size", kAllRenderers, OptionCondition::Always, {"8", "6"}},
     {"--spp", kAllRenderers, OptionCondition::Always, {"4"}},
+    {"--exposure", kAllRenderers, OptionCondition::Always, {"1.5"}},
     {"--threads", kAllRenderers, OptionCondition::Always, {"1"}},
     {"--debug-pixel", kAllRenderers, OptionCondition::Always, {"1", "1"}},
     {"--max-memory", kAllRenderers, OptionCondition::Always, {"8G"}},
