@@ -73,7 +73,7 @@ TEST(Crossval, SortedTransparencyIsFlaggedAsWrongOnCyclicOverlap) {
 }
 
 TEST(Crossval, ReportIsSelfContained) {
-  const std::string dir = "report_" + std::to_string(getpid());
+  const std::string dir = test::scratchPath("report");
   const auto r = runRastray({"crossval", scene("cornell-box"), scene("three-triangles"), "--size", "80", "60",
                              "--report", dir, "--shadow-map-size", "256"});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -230,9 +230,7 @@ TEST(Explain, JsonHasTheSameEventsAsTheText) {
 // --debug-pixel: the rasterizer records, the command prints the events to
 // stderr after the render; without it nothing reaches stderr.
 TEST(DebugPixel, RenderPrintsTheRasterTraceOnStderr) {
-  const std::string png =
-      (std::filesystem::temp_directory_path() / ("rastray-debug-pixel-" + std::to_string(getpid()) + ".png"))
-          .string();
+  const std::string png = test::scratchPath("debug-pixel.png");
   const auto traced = runRastray({"render", scene("three-triangles"), "--size", "80", "80", "--spp", "4",
                                   "--debug-pixel", "40", "40", "-o", png});
   ASSERT_EQ(traced.status, 0) << traced.err;

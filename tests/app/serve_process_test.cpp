@@ -30,7 +30,7 @@ std::string scenePath(const char* name) { return std::string(RASTRAY_SCENES) + "
 using test::slurp;
 
 fs::path freshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("rastray-" + name + "-" + std::to_string(getpid()));
+  const fs::path dir = test::scratchDir() / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -33,16 +33,15 @@ const std::string kScenes = RASTRAY_SCENES;
 
 using test::slurp;
 
-// A fresh folder under the system temp dir, removed at the end of the test.
+// A fresh folder under the test's scratch directory (tests/test_files.h:
+// removed when the test passes, kept when it fails).
 struct TempDir {
   std::filesystem::path path;
   explicit TempDir(const std::string& name) {
-    path =
-        std::filesystem::temp_directory_path() / ("rastray-sweep-" + name + "-" + std::to_string(getpid()));
+    path = test::scratchDir() / name;
     std::filesystem::remove_all(path);
     std::filesystem::create_directories(path);
   }
-  ~TempDir() { std::filesystem::remove_all(path); }
   std::string operator/(const std::string& name) const { return (path / name).string(); }
 };
 

@@ -18,6 +18,7 @@
 #include "common/error.h"
 #include "common/image.h"
 #include "common/scene.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -29,12 +30,8 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 class ImageChannelsTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("rastray_image_channels_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::scratchDir();  // removed when the test passes
   }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   fs::path dir_;

@@ -20,6 +20,7 @@
 
 #include "common/error.h"
 #include "common/scene.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -32,16 +33,12 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 class ImageTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ =
-        fs::temp_directory_path() / ("rastray_image_test_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = test::scratchDir();  // removed when the test passes
   }
   void TearDown() override {
+    // A test made it read-only: writable again, so it can be removed.
     std::error_code ignored;
     fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add, ignored);
-    fs::remove_all(dir_, ignored);
   }
 
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
@@ -189,8 +186,7 @@ TEST_F(ImageTest, ExrChannelTypeNamesEachChannelsStoredType) {
   writeImage(half, testImage(), ColorPrecision::Half);
   writeImage(full, testImage(), ColorPrecision::Float);
   for (const auto& [file, color] : {std::pair{half, "half"}, std::pair{full, "float"}}) {
-    for (const char* c : {"R", "G", "B", "A"})
-      EXPECT_EQ(exrChannelType(file, c), color) << file << " " << c;
+    for (const char* c : {"R", "G", "B", "A"}) EXPECT_EQ(exrChannelType(file, c), color) << file << " " << c;
     EXPECT_EQ(exrChannelType(file, "Z"), "float");
     EXPECT_EQ(exrChannelType(file, "id.instance"), "uint");
     EXPECT_EQ(exrChannelType(file, "Y"), "");
