@@ -21,9 +21,10 @@ constexpr const char* kModuleName = "rastray_oiio.so";
 std::atomic<bool> loaded{false};
 
 // Where to look, in order: beside the running program, one folder up (the
-// test, bench and fuzz programs sit in subfolders of the build), then the
-// path the build wrote it to (a program run from elsewhere, e.g. a Python
-// module later).
+// test, bench and fuzz programs sit in subfolders of the build), beside the
+// shared object holding this code when that is not the program (the Python
+// module, python/, installed with the module beside it), then the path the
+// build wrote it to (a program run from elsewhere).
 std::vector<std::string> candidatePaths() {
   std::vector<std::string> paths;
   std::error_code error;
@@ -31,6 +32,11 @@ std::vector<std::string> candidatePaths() {
   if (!error) {
     paths.push_back((self.parent_path() / kModuleName).string());
     paths.push_back((self.parent_path().parent_path() / kModuleName).string());
+  }
+  Dl_info info;
+  if (dladdr(reinterpret_cast<void*>(&candidatePaths), &info) && info.dli_fname && info.dli_fname[0] == '/') {
+    const std::filesystem::path object(info.dli_fname);
+    if (object != self) paths.push_back((object.parent_path() / kModuleName).string());
   }
 #ifdef RASTRAY_OIIO_MODULE_PATH
   paths.push_back(RASTRAY_OIIO_MODULE_PATH);

@@ -21,6 +21,7 @@ packages=(
   clang libfuzzer-14-dev libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer targets (fuzz/, -DRASTRAY_FUZZ=ON) need clang
   libdraco-dev draco libmeshoptimizer-dev gltfpack  # compressed glTF: Draco and meshopt decoders; encoders make the test files
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib  # the Python module (python/) and its tests
+  python3-venv python3-wheel  # `pip install ./python` into a virtual environment (docs/PYTHON.md, tests/python/test_install.py)
   povray  # an independent Whitted ray tracer: the shadow-mask comparison (docs/SHADOWS.md)
 )
 
