@@ -30,3 +30,16 @@ def test_worked_example_runs_and_draws_the_picture(tmp_path, monkeypatch, capsys
     assert (tmp_path / "python-example.png").stat().st_size > 10000
     # The picture the page shows is committed beside it.
     assert os.path.exists(os.path.join(SOURCE, "docs", "images", "python-example.png"))
+
+
+def test_readme_example_runs(tmp_path, monkeypatch):
+    with open(os.path.join(SOURCE, "README.md"), encoding="utf-8") as f:
+        blocks = python_blocks(f.read())
+    assert len(blocks) == 1
+    os.symlink(os.path.abspath(SCENES), tmp_path / "scenes")
+    monkeypatch.chdir(tmp_path)
+    namespace = {"__name__": "__readme__"}
+    exec(compile(blocks[0], "README.md", "exec"), namespace)
+    # What the block's comment says.
+    assert namespace["frame"].color.shape == (240, 320, 4)
+    assert namespace["frame"].depth.shape == (240, 320)
