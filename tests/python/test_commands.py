@@ -99,3 +99,12 @@ def test_compare_frames_matches_compare_of_their_files(tmp_path, cornell):
     assert mixed["visibility"] == files["visibility"]
     with pytest.raises(ValueError, match="spp"):
         rastray.compare(fa, rastray.render(cornell, renderer="raytrace", size=(80, 60), spp=1))
+
+
+def test_compare_of_crossval_frames_is_deep_and_counts_as_crossval(cornell):
+    result = rastray.crossval(cornell, size=(48, 36), spp=4)
+    deep = rastray.compare(result.raster, result.raytrace).summary
+    assert deep["kind"] == "deep" and deep["spp"] == 4
+    mine, theirs = deep["visibility"]["layers"], result.summary["rasterVsRaytrace"]["visibility"]["layers"]
+    assert (mine["compared"], mine["agreeing"]) == (theirs["compared"], theirs["agreeing"])
+    assert (rastray.compare(result.raster, result.raytrace).mismatch_map == result.mismatch_map).all()
