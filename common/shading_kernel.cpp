@@ -13,6 +13,7 @@
 
 #include <hwy/highway.h>
 
+#include "common/primary_refinement-inl.h"
 #include "common/shading_kernel.h"
 
 #ifndef RASTRAY_SHADING_KERNEL_LANES
@@ -246,48 +247,29 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
 
 size_t RefineLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
-// intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp}),
-// operation for operation: glm's cross (x.y·y.z − y.y·x.z, ...) and dot
-// ((x + y) + z), the canonical slots mapped back, the plane kept only ahead
-// of the ray, the clamp max(b, 0) as glm's (b < 0 ? 0 : b), then the scale
-// onto the edge v1–v2.
+// intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp})
+// per lane: common/primary_refinement-inl.h, with s = origin − a,
+// q = s × e1 and e2 · q computed per lane as the scalar memo computes them.
 void LanesRefine(kernel_detail::RefineBlock* b) {
   const hn::ScalableTag<double> d;
   const size_t N = hn::Lanes(d);
-  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  const auto one = hn::Set(d, 1.0);
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto dx = hn::Load(d, b->dx + i), dy = hn::Load(d, b->dy + i), dz = hn::Load(d, b->dz + i);
-    const auto e1x = hn::Load(d, b->e1x + i), e1y = hn::Load(d, b->e1y + i), e1z = hn::Load(d, b->e1z + i);
-    const auto e2x = hn::Load(d, b->e2x + i), e2y = hn::Load(d, b->e2y + i), e2z = hn::Load(d, b->e2z + i);
-    // p = direction × e2
-    const auto px = hn::Sub(hn::Mul(dy, e2z), hn::Mul(e2y, dz));
-    const auto py = hn::Sub(hn::Mul(dz, e2x), hn::Mul(e2z, dx));
-    const auto pz = hn::Sub(hn::Mul(dx, e2y), hn::Mul(e2x, dy));
-    const auto det = hn::Add(hn::Add(hn::Mul(e1x, px), hn::Mul(e1y, py)), hn::Mul(e1z, pz));
-    auto ok = hn::Gt(hn::Abs(det), zero);
-    const auto inv = hn::Div(one, det);
+    RefinePlaneLanes<hn::Vec<decltype(d)>> pl;
+    pl.e1x = hn::Load(d, b->e1x + i), pl.e1y = hn::Load(d, b->e1y + i), pl.e1z = hn::Load(d, b->e1z + i);
+    pl.e2x = hn::Load(d, b->e2x + i), pl.e2y = hn::Load(d, b->e2y + i), pl.e2z = hn::Load(d, b->e2z + i);
     // s = origin − a, q = s × e1
-    const auto sx = hn::Sub(hn::Load(d, b->ox + i), hn::Load(d, b->ax + i));
-    const auto sy = hn::Sub(hn::Load(d, b->oy + i), hn::Load(d, b->ay + i));
-    const auto sz = hn::Sub(hn::Load(d, b->oz + i), hn::Load(d, b->az + i));
-    const auto u = hn::Mul(hn::Add(hn::Add(hn::Mul(sx, px), hn::Mul(sy, py)), hn::Mul(sz, pz)), inv);
-    const auto qx = hn::Sub(hn::Mul(sy, e1z), hn::Mul(e1y, sz));
-    const auto qy = hn::Sub(hn::Mul(sz, e1x), hn::Mul(e1z, sx));
-    const auto qz = hn::Sub(hn::Mul(sx, e1y), hn::Mul(e1x, sy));
-    const auto w = hn::Mul(hn::Add(hn::Add(hn::Mul(dx, qx), hn::Mul(dy, qy)), hn::Mul(dz, qz)), inv);
-    const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(e2x, qx), hn::Mul(e2y, qy)), hn::Mul(e2z, qz)), inv);
-    ok = hn::And(ok, hn::And(hn::IsFinite(t), hn::And(hn::IsFinite(u), hn::IsFinite(w))));
-    const auto w0 = hn::Sub(hn::Sub(one, u), w);
-    const auto s1 = hn::Load(d, b->slot1 + i), s2 = hn::Load(d, b->slot2 + i);
-    auto b1 = hn::IfThenElse(hn::Eq(s1, zero), w0, hn::IfThenElse(hn::Eq(s1, one), u, w));
-    auto b2 = hn::IfThenElse(hn::Eq(s2, zero), w0, hn::IfThenElse(hn::Eq(s2, one), u, w));
-    ok = hn::And(ok, hn::And(hn::Gt(t, zero), hn::IsFinite(hn::Mul(t, hn::Load(d, b->depthPerT + i)))));
-    b1 = hn::IfThenElse(hn::Lt(b1, zero), zero, b1);
-    b2 = hn::IfThenElse(hn::Lt(b2, zero), zero, b2);
-    const auto sum = hn::Add(b1, b2);
-    const auto over = hn::Gt(sum, one);
-    b1 = hn::IfThenElse(over, hn::Div(b1, sum), b1);
-    b2 = hn::IfThenElse(over, hn::Div(b2, sum), b2);
+    pl.sx = hn::Sub(hn::Load(d, b->ox + i), hn::Load(d, b->ax + i));
+    pl.sy = hn::Sub(hn::Load(d, b->oy + i), hn::Load(d, b->ay + i));
+    pl.sz = hn::Sub(hn::Load(d, b->oz + i), hn::Load(d, b->az + i));
+    pl.qx = hn::Sub(hn::Mul(pl.sy, pl.e1z), hn::Mul(pl.e1y, pl.sz));
+    pl.qy = hn::Sub(hn::Mul(pl.sz, pl.e1x), hn::Mul(pl.e1z, pl.sx));
+    pl.qz = hn::Sub(hn::Mul(pl.sx, pl.e1y), hn::Mul(pl.e1x, pl.sy));
+    pl.e2DotQ = hn::Add(hn::Add(hn::Mul(pl.e2x, pl.qx), hn::Mul(pl.e2y, pl.qy)), hn::Mul(pl.e2z, pl.qz));
+    pl.slot1 = hn::Load(d, b->slot1 + i), pl.slot2 = hn::Load(d, b->slot2 + i);
+    hn::Vec<decltype(d)> b1, b2;
+    const auto ok = RefineOnPlane(d, hn::Load(d, b->dx + i), hn::Load(d, b->dy + i), hn::Load(d, b->dz + i),
+                                  hn::Load(d, b->depthPerT + i), pl, &b1, &b2);
     hn::Store(b1, d, b->b1 + i);
     hn::Store(b2, d, b->b2 + i);
     hn::Store(hn::IfThenElseZero(ok, one), d, b->refined + i);
@@ -584,26 +566,41 @@ class BlockShader {
 }  // namespace
 
 void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,
-                      ShadingPath path) {
+                      const uint32_t* colorIndex, ShadingPath path) {
+  const auto out = [&](size_t i) -> glm::vec4& { return colors[colorIndex ? colorIndex[i] : i]; };
   if (path == ShadingPath::Reference || shader.options().referenceShading) {
-    for (size_t i = 0; i < count; ++i) colors[i] = shadeReference(shader, hits[i]);
+    for (size_t i = 0; i < count; ++i) out(i) = shadeReference(shader, hits[i]);
     return;
   }
   // Built at the first lane: a batch of scalar-path hits (a BLEND layer)
   // needs none of it.
   std::optional<BlockShader> block;
+  // The path is a function of the material: decided once per run of hits
+  // on one instance.
+  uint32_t runInstance = kNoId;
+  const Material* material = nullptr;
+  bool scalar = false;
   for (size_t i = 0; i < count; ++i) {
     const ShadeHit& h = hits[i];
-    const Material& m = shader.scene().materialOf(h.instance);
-    if (needsScalarShade(shader, m)) {
-      colors[i] = shadeReference(shader, h);
+    if (h.instance != runInstance) {
+      runInstance = h.instance;
+      material = &shader.scene().materialOf(h.instance);
+      scalar = needsScalarShade(shader, *material);
+    }
+    if (scalar) {
+      out(i) = shadeReference(shader, h);
       continue;
     }
     if (!block) block.emplace(shader);
-    block->add(h, m, &colors[i]);
+    block->add(h, *material, &out(i));
     if (block->full()) block->run();
   }
   if (block) block->run();
+}
+
+void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,
+                      ShadingPath path) {
+  shadePrimaryHits(shader, hits, count, colors, nullptr, path);
 }
 
 void refinePrimaryHits(const Scene& scene, const Ray* rays, const SampleHit* hits,
