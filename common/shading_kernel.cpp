@@ -30,19 +30,25 @@ constexpr size_t kBlock = 64;
 struct LaneBlock {
   size_t used = 0;   // lanes holding a hit
   size_t lanes = 0;  // used rounded up to whole vectors of the running target: what the lanes run over
-  // Inputs.
+  size_t runs = 0;   // entries of the per-run table below
+  // Inputs, per lane.
+  alignas(64) int32_t run[kBlock];                             // the lane's run; non-decreasing
   alignas(64) float dirX[kBlock], dirY[kBlock], dirZ[kBlock];  // primary ray direction
-  alignas(64) float side[kBlock];                           // +1 entering (d·ng < 0, in double), else −1
+  alignas(64) float side[kBlock];                        // +1 entering (d·ng < 0, in double), else −1
+  alignas(64) float b0[kBlock], b1[kBlock], b2[kBlock];  // b0 = 1 − b1 − b2 in double, rounded
+  alignas(64) float albedoR[kBlock], albedoG[kBlock], albedoB[kBlock];  // base colour RGB (scalar, as Shader)
+  alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
+  // Inputs, per run of lanes on one triangle (indexed by `run`): stored
+  // once, read as a broadcast by a vector of lanes on one run, else
+  // gathered (RunValue).
   alignas(64) float ngX[kBlock], ngY[kBlock], ngZ[kBlock];  // face normal (double, memoised), rounded
   alignas(64) float authored[kBlock];  // 1: interpolate the corner normals below, 0: the face normal
-  alignas(64) float b0[kBlock], b1[kBlock], b2[kBlock];  // b0 = 1 − b1 − b2 in double, rounded
   alignas(64) float n0X[kBlock], n0Y[kBlock], n0Z[kBlock];
   alignas(64) float n1X[kBlock], n1Y[kBlock], n1Z[kBlock];
   alignas(64) float n2X[kBlock], n2Y[kBlock], n2Z[kBlock];
-  alignas(64) float albedoR[kBlock], albedoG[kBlock], albedoB[kBlock];  // base colour RGB (scalar, as Shader)
-  alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
-  alignas(64) float diffuseWeight[kBlock];                              // (1 − w)(1 − t)
-  alignas(64) float alpha[kBlock];                                      // BLEND: base alpha; else 1
+  alignas(64) float diffuseWeight[kBlock];  // (1 − w)(1 − t)
+  // Per lane again.
+  alignas(64) float alpha[kBlock];  // BLEND: base alpha; else 1
   // Per light, refilled for each light: light − position (the vector to the
   // light) in double, rounded.
   alignas(64) float toLightX[kBlock], toLightY[kBlock], toLightZ[kBlock];
@@ -99,6 +105,18 @@ using kernel_detail::LaneLight;
 // Lanes per vector of the running target.
 size_t KernelLanes() { return hn::Lanes(hn::ScalableTag<float>()); }
 
+// A per-run value for the vector of lanes starting at lane i: a broadcast
+// when they all lie on one run (runs are non-decreasing, so first == last
+// says so), else a gather. The same value either way.
+template <class D>
+HWY_INLINE hn::Vec<D> RunValue(D d, const LaneBlock* b, size_t i, const float* table) {
+  const size_t N = hn::Lanes(d);
+  const int32_t first = b->run[i];
+  if (first == b->run[i + N - 1]) return hn::Set(d, table[first]);
+  const hn::RebindToSigned<D> di;
+  return hn::GatherIndex(d, table, hn::Load(di, b->run + i));
+}
+
 // The lighting normal of each lane (Shader::shade's n): the shading
 // normal (authored, interpolated and normalised; else the face normal) on
 // the viewer's side, or the face normal's when that one faces away.
@@ -109,21 +127,19 @@ void LanesNormals(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto inf = hn::Set(d, std::numeric_limits<float>::infinity());
   for (size_t i = 0; i < b->lanes; i += N) {
+    const auto get = [&](const float* table) { return RunValue(d, b, i, table); };
     const auto b0 = hn::Load(d, b->b0 + i), b1 = hn::Load(d, b->b1 + i), b2 = hn::Load(d, b->b2 + i);
     const auto sx =
-        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0X + i)), hn::Mul(b1, hn::Load(d, b->n1X + i))),
-                hn::Mul(b2, hn::Load(d, b->n2X + i)));
+        hn::Add(hn::Add(hn::Mul(b0, get(b->n0X)), hn::Mul(b1, get(b->n1X))), hn::Mul(b2, get(b->n2X)));
     const auto sy =
-        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0Y + i)), hn::Mul(b1, hn::Load(d, b->n1Y + i))),
-                hn::Mul(b2, hn::Load(d, b->n2Y + i)));
+        hn::Add(hn::Add(hn::Mul(b0, get(b->n0Y)), hn::Mul(b1, get(b->n1Y))), hn::Mul(b2, get(b->n2Y)));
     const auto sz =
-        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0Z + i)), hn::Mul(b1, hn::Load(d, b->n1Z + i))),
-                hn::Mul(b2, hn::Load(d, b->n2Z + i)));
+        hn::Add(hn::Add(hn::Mul(b0, get(b->n0Z)), hn::Mul(b1, get(b->n1Z))), hn::Mul(b2, get(b->n2Z)));
     const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(sx, sx), hn::Mul(sy, sy)), hn::Mul(sz, sz)));
-    const auto gx = hn::Load(d, b->ngX + i), gy = hn::Load(d, b->ngY + i), gz = hn::Load(d, b->ngZ + i);
+    const auto gx = get(b->ngX), gy = get(b->ngY), gz = get(b->ngZ);
     // A zero (or overflowing) interpolated normal keeps the face normal.
-    const auto useAuthored = hn::And(hn::Gt(hn::Load(d, b->authored + i), zero),
-                                     hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
+    const auto useAuthored =
+        hn::And(hn::Gt(get(b->authored), zero), hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
     const auto side = hn::Load(d, b->side + i);
     const auto fx = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sx, length), gx));
     const auto fy = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sy, length), gy));
@@ -229,7 +245,7 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto invPi = hn::Set(d, eyeLight ? 1.0f : float(0.31830988618379067154));
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto diffuse = hn::Load(d, b->diffuseWeight + i);
+    const auto diffuse = RunValue(d, b, i, b->diffuseWeight);
     const auto hasDiffuse = hn::Gt(diffuse, zero);
     const auto alpha = hn::Load(d, b->alpha + i);
     const auto channel = [&](const float* albedo, const float* sum, const float* emit, float* out) {
@@ -392,7 +408,21 @@ class BlockShader {
     outputs_[i] = out;
     // Consecutive hits mostly share a triangle: its data is looked up once
     // per run (the same values, so the lane does not depend on the run).
-    if (h.instance != run_.instance || h.triangle != run_.triangle) startRun(h.instance, h.triangle);
+    const bool newTriangle = h.instance != run_.instance || h.triangle != run_.triangle;
+    if (newTriangle) startRun(h.instance, h.triangle);
+    if (newTriangle || b.runs == 0) {
+      // The run's entry in the block's table.
+      const size_t r = b.runs++;
+      b.ngX[r] = run_.ngF.x;
+      b.ngY[r] = run_.ngF.y;
+      b.ngZ[r] = run_.ngF.z;
+      b.authored[r] = run_.authored ? 1.0f : 0.0f;
+      b.n0X[r] = run_.n0.x, b.n0Y[r] = run_.n0.y, b.n0Z[r] = run_.n0.z;
+      b.n1X[r] = run_.n1.x, b.n1Y[r] = run_.n1.y, b.n1Z[r] = run_.n1.z;
+      b.n2X[r] = run_.n2.x, b.n2Y[r] = run_.n2.y, b.n2Z[r] = run_.n2.z;
+      b.diffuseWeight[r] = (1.0f - m.mirrorWeight()) * (1.0f - m.transmission);
+    }
+    b.run[i] = int32_t(b.runs - 1);
     const Instance& inst = *run_.inst;
     const glm::uvec3 t = run_.corners;
     const double b0 = 1.0 - double(h.b1) - double(h.b2);
@@ -400,19 +430,12 @@ class BlockShader {
     // makeSurfacePoint and Shader::shade decide it.
     const bool entering = isEntering(h.direction, run_.ng);
     b.side[i] = entering ? 1.0f : -1.0f;
-    b.ngX[i] = run_.ngF.x;
-    b.ngY[i] = run_.ngF.y;
-    b.ngZ[i] = run_.ngF.z;
     b.dirX[i] = float(h.direction.x);
     b.dirY[i] = float(h.direction.y);
     b.dirZ[i] = float(h.direction.z);
     b.b0[i] = float(b0);
     b.b1[i] = h.b1;
     b.b2[i] = h.b2;
-    b.authored[i] = run_.authored ? 1.0f : 0.0f;
-    b.n0X[i] = run_.n0.x, b.n0Y[i] = run_.n0.y, b.n0Z[i] = run_.n0.z;
-    b.n1X[i] = run_.n1.x, b.n1Y[i] = run_.n1.y, b.n1Z[i] = run_.n1.z;
-    b.n2X[i] = run_.n2.x, b.n2Y[i] = run_.n2.y, b.n2Z[i] = run_.n2.z;
 
     // Base colour and emission: Shader::baseColor and emission's float
     // steps, here with the textures sampled through the pixel footprint.
@@ -440,8 +463,6 @@ class BlockShader {
     b.emitR[i] = emit.r;
     b.emitG[i] = emit.g;
     b.emitB[i] = emit.b;
-    const float w = m.mirrorWeight();
-    b.diffuseWeight[i] = (1.0f - w) * (1.0f - m.transmission);
     b.alpha[i] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
     if (!shader_.eyeLight()) positions_[i] = b0 * run_.p0 + double(h.b1) * run_.p1 + double(h.b2) * run_.p2;
   }
@@ -493,6 +514,7 @@ class BlockShader {
     HWY_DYNAMIC_DISPATCH(LanesFinish)(&b, eyeLight);
     for (size_t i = 0; i < b.used; ++i) *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
     b.used = 0;
+    b.runs = 0;
   }
 
  private:
@@ -528,7 +550,8 @@ class BlockShader {
   }
 
   // Fills the lanes from `used` to a whole number of vectors with a
-  // harmless surface (unit normals, no light, no colour), never read back.
+  // harmless surface (the last run's normals, no light, no colour), never
+  // read back.
   void padLanes() {
     LaneBlock& b = block_;
     b.lanes = (b.used + vectorLanes_ - 1) / vectorLanes_ * vectorLanes_;
@@ -536,15 +559,11 @@ class BlockShader {
       b.dirX[i] = b.dirY[i] = 0.0f;
       b.dirZ[i] = -1.0f;
       b.side[i] = 1.0f;
-      b.ngX[i] = b.ngY[i] = 0.0f;
-      b.ngZ[i] = 1.0f;
-      b.authored[i] = 0.0f;
+      b.run[i] = int32_t(b.runs - 1);  // the last run's normals; no colour below
       b.b0[i] = 1.0f;
       b.b1[i] = b.b2[i] = 0.0f;
-      b.n0X[i] = b.n0Y[i] = b.n0Z[i] = b.n1X[i] = b.n1Y[i] = b.n1Z[i] = b.n2X[i] = b.n2Y[i] = b.n2Z[i] = 0.0f;
       b.albedoR[i] = b.albedoG[i] = b.albedoB[i] = 0.0f;
       b.emitR[i] = b.emitG[i] = b.emitB[i] = 0.0f;
-      b.diffuseWeight[i] = 0.0f;
       b.alpha[i] = 1.0f;
       b.toLightX[i] = b.toLightY[i] = 0.0f;
       b.toLightZ[i] = 1.0f;

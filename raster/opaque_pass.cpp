@@ -54,17 +54,24 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   thread_local std::vector<glm::dvec2> footprints;  // image position of the texture footprint
   thread_local std::vector<ShadeHit> requests;      // refined
   thread_local std::vector<Assignment> assignments;
-  winners.clear();
-  positions.clear();
-  requestLocal.clear();
-  footprints.clear();
+  // At most one request per sample: sized once, filled through plain
+  // pointers (no push_back on thread-local vectors in the sample loop).
+  const size_t most = index.count();
+  for (auto* v : {&winners, &requestLocal}) v->resize(std::max(v->size(), most));
+  for (auto* v : {&positions, &footprints}) v->resize(std::max(v->size(), most));
+  uint32_t* const winnerOut = winners.data();
+  uint32_t* const localOut = requestLocal.data();
+  glm::dvec2* const positionOut = positions.data();
+  glm::dvec2* const footprintOut = footprints.data();
+  size_t count = 0;
   assignments.clear();
   const auto addRequest = [&](uint32_t win, uint32_t local, const glm::dvec2& pos,
                               const glm::dvec2& footprint) {
-    winners.push_back(win);
-    positions.push_back(pos);
-    requestLocal.push_back(local);
-    footprints.push_back(footprint);
+    winnerOut[count] = win;
+    localOut[count] = local;
+    positionOut[count] = pos;
+    footprintOut[count] = footprint;
+    ++count;
   };
   const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
   std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, local)
@@ -104,7 +111,6 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
       }
     }
   }
-  const size_t count = winners.size();
   hits.resize(count);
   requests.resize(count);
   primaryShadeHits(primaryConstants_, scene_, setups_.data(), winners.data(), positions.data(),
