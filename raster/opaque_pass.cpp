@@ -33,14 +33,15 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   // storage is only sized, never filled first.
   samples.color.resize(index.count());
   samples.front.resize(index.count());
-  // The tile's winning samples in two steps: gather the hits to shade
-  // (in pixel and sample order) and compute, per block of them in double
-  // lanes, the interpolated hit, the primary ray and the hit refined on its
-  // stored triangle's plane (primaryShadeHits: primarySamples' and
-  // refinePrimaryHits' bits, raster/primary_samples.h); then shade them as
-  // one batch through the shading kernel (common/shading_kernel.h), the one
-  // the ray caster shades its primary hits with, straight into the tile's
-  // colours. At shading rate pixel a sample takes the colour of the first
+  // The tile's winning samples in two steps, a chunk of them at a time:
+  // gather the hits to shade (in pixel and sample order) and compute, per
+  // block of them in double lanes, the interpolated hit, the primary ray
+  // and the hit refined on its stored triangle's plane (primaryShadeHits:
+  // primarySamples' and refinePrimaryHits' bits, raster/primary_samples.h);
+  // then shade them through the shading kernel (common/shading_kernel.h),
+  // the one the ray caster shades its primary hits with, straight into the
+  // tile's colours. A hit's colour does not depend on its chunk (the
+  // kernel's lane independence). At shading rate pixel a sample takes the colour of the first
   // sample of its pixel on the same triangle. Per-thread scratch: no
   // allocation per tile once grown.
   struct Assignment {
@@ -54,24 +55,37 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   thread_local std::vector<glm::dvec2> footprints;  // image position of the texture footprint
   thread_local std::vector<ShadeHit> requests;      // refined
   thread_local std::vector<Assignment> assignments;
-  // At most one request per sample: sized once, filled through plain
-  // pointers (no push_back on thread-local vectors in the sample loop).
-  const size_t most = index.count();
-  for (auto* v : {&winners, &requestLocal}) v->resize(std::max(v->size(), most));
-  for (auto* v : {&positions, &footprints}) v->resize(std::max(v->size(), most));
+  // Requests are shaded a chunk at a time as the loop gathers them, so a
+  // chunk's inputs, hits and refined requests stay in the core's caches
+  // (a whole tile's would not: about 0.7 MB at 1 spp). Sized once, filled
+  // through plain pointers (no push_back in the sample loop).
+  constexpr size_t kChunk = 256;
+  for (auto* v : {&winners, &requestLocal}) v->resize(kChunk);
+  for (auto* v : {&positions, &footprints}) v->resize(kChunk);
+  hits.resize(kChunk);
+  requests.resize(kChunk);
   uint32_t* const winnerOut = winners.data();
   uint32_t* const localOut = requestLocal.data();
   glm::dvec2* const positionOut = positions.data();
   glm::dvec2* const footprintOut = footprints.data();
   size_t count = 0;
   assignments.clear();
+  // The chunk's hits into the tile's samples, then its colours.
+  const auto flush = [&] {
+    primaryShadeHits(primaryConstants_, scene_, setups_.data(), winnerOut, positionOut, footprintOut, count,
+                     hits.data(), requests.data());
+    for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = hits[r];
+    shadePrimaryHits(shader_, requests.data(), count, samples.color.data(), localOut, shadingPath());
+    n.shadedSamples += count;
+    count = 0;
+  };
   const auto addRequest = [&](uint32_t win, uint32_t local, const glm::dvec2& pos,
                               const glm::dvec2& footprint) {
     winnerOut[count] = win;
     localOut[count] = local;
     positionOut[count] = pos;
     footprintOut[count] = footprint;
-    ++count;
+    if (++count == kChunk) flush();
   };
   const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
   std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, local)
@@ -111,13 +125,8 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
       }
     }
   }
-  hits.resize(count);
-  requests.resize(count);
-  primaryShadeHits(primaryConstants_, scene_, setups_.data(), winners.data(), positions.data(),
-                   footprints.data(), count, hits.data(), requests.data());
-  for (size_t r = 0; r < count; ++r) samples.front[requestLocal[r]] = hits[r];
-  shadePrimaryHits(shader_, requests.data(), count, samples.color.data(), requestLocal.data(), shadingPath());
-  n.shadedSamples += count;
+  if (count > 0) flush();
+  // After every chunk: a source sample's colour is final.
   for (const Assignment& a : assignments) samples.color[a.local] = samples.color[a.source];
 
   if (trace.sink && trace.pixel.x >= rect.x0 && trace.pixel.x < rect.x1 && trace.pixel.y >= rect.y0 &&
