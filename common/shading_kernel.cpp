@@ -13,6 +13,7 @@
 
 #include <hwy/highway.h>
 
+#include "common/primary_refinement-inl.h"
 #include "common/shading_kernel.h"
 
 #ifndef RASTRAY_SHADING_KERNEL_LANES
@@ -29,19 +30,25 @@ constexpr size_t kBlock = 64;
 struct LaneBlock {
   size_t used = 0;   // lanes holding a hit
   size_t lanes = 0;  // used rounded up to whole vectors of the running target: what the lanes run over
-  // Inputs.
+  size_t runs = 0;   // entries of the per-run table below
+  // Inputs, per lane.
+  alignas(64) int32_t run[kBlock];                             // the lane's run; non-decreasing
   alignas(64) float dirX[kBlock], dirY[kBlock], dirZ[kBlock];  // primary ray direction
-  alignas(64) float side[kBlock];                           // +1 entering (d·ng < 0, in double), else −1
+  alignas(64) float side[kBlock];                        // +1 entering (d·ng < 0, in double), else −1
+  alignas(64) float b0[kBlock], b1[kBlock], b2[kBlock];  // b0 = 1 − b1 − b2 in double, rounded
+  alignas(64) float albedoR[kBlock], albedoG[kBlock], albedoB[kBlock];  // base colour RGB (scalar, as Shader)
+  alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
+  // Inputs, per run of lanes on one triangle (indexed by `run`): stored
+  // once, read as a broadcast by a vector of lanes on one run, else
+  // gathered (RunValue).
   alignas(64) float ngX[kBlock], ngY[kBlock], ngZ[kBlock];  // face normal (double, memoised), rounded
   alignas(64) float authored[kBlock];  // 1: interpolate the corner normals below, 0: the face normal
-  alignas(64) float b0[kBlock], b1[kBlock], b2[kBlock];  // b0 = 1 − b1 − b2 in double, rounded
   alignas(64) float n0X[kBlock], n0Y[kBlock], n0Z[kBlock];
   alignas(64) float n1X[kBlock], n1Y[kBlock], n1Z[kBlock];
   alignas(64) float n2X[kBlock], n2Y[kBlock], n2Z[kBlock];
-  alignas(64) float albedoR[kBlock], albedoG[kBlock], albedoB[kBlock];  // base colour RGB (scalar, as Shader)
-  alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
-  alignas(64) float diffuseWeight[kBlock];                              // (1 − w)(1 − t)
-  alignas(64) float alpha[kBlock];                                      // BLEND: base alpha; else 1
+  alignas(64) float diffuseWeight[kBlock];  // (1 − w)(1 − t)
+  // Per lane again.
+  alignas(64) float alpha[kBlock];  // BLEND: base alpha; else 1
   // Per light, refilled for each light: light − position (the vector to the
   // light) in double, rounded.
   alignas(64) float toLightX[kBlock], toLightY[kBlock], toLightZ[kBlock];
@@ -98,6 +105,18 @@ using kernel_detail::LaneLight;
 // Lanes per vector of the running target.
 size_t KernelLanes() { return hn::Lanes(hn::ScalableTag<float>()); }
 
+// A per-run value for the vector of lanes starting at lane i: a broadcast
+// when they all lie on one run (runs are non-decreasing, so first == last
+// says so), else a gather. The same value either way.
+template <class D>
+HWY_INLINE hn::Vec<D> RunValue(D d, const LaneBlock* b, size_t i, const float* table) {
+  const size_t N = hn::Lanes(d);
+  const int32_t first = b->run[i];
+  if (first == b->run[i + N - 1]) return hn::Set(d, table[first]);
+  const hn::RebindToSigned<D> di;
+  return hn::GatherIndex(d, table, hn::Load(di, b->run + i));
+}
+
 // The lighting normal of each lane (Shader::shade's n): the shading
 // normal (authored, interpolated and normalised; else the face normal) on
 // the viewer's side, or the face normal's when that one faces away.
@@ -108,21 +127,19 @@ void LanesNormals(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto inf = hn::Set(d, std::numeric_limits<float>::infinity());
   for (size_t i = 0; i < b->lanes; i += N) {
+    const auto get = [&](const float* table) { return RunValue(d, b, i, table); };
     const auto b0 = hn::Load(d, b->b0 + i), b1 = hn::Load(d, b->b1 + i), b2 = hn::Load(d, b->b2 + i);
     const auto sx =
-        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0X + i)), hn::Mul(b1, hn::Load(d, b->n1X + i))),
-                hn::Mul(b2, hn::Load(d, b->n2X + i)));
+        hn::Add(hn::Add(hn::Mul(b0, get(b->n0X)), hn::Mul(b1, get(b->n1X))), hn::Mul(b2, get(b->n2X)));
     const auto sy =
-        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0Y + i)), hn::Mul(b1, hn::Load(d, b->n1Y + i))),
-                hn::Mul(b2, hn::Load(d, b->n2Y + i)));
+        hn::Add(hn::Add(hn::Mul(b0, get(b->n0Y)), hn::Mul(b1, get(b->n1Y))), hn::Mul(b2, get(b->n2Y)));
     const auto sz =
-        hn::Add(hn::Add(hn::Mul(b0, hn::Load(d, b->n0Z + i)), hn::Mul(b1, hn::Load(d, b->n1Z + i))),
-                hn::Mul(b2, hn::Load(d, b->n2Z + i)));
+        hn::Add(hn::Add(hn::Mul(b0, get(b->n0Z)), hn::Mul(b1, get(b->n1Z))), hn::Mul(b2, get(b->n2Z)));
     const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(sx, sx), hn::Mul(sy, sy)), hn::Mul(sz, sz)));
-    const auto gx = hn::Load(d, b->ngX + i), gy = hn::Load(d, b->ngY + i), gz = hn::Load(d, b->ngZ + i);
+    const auto gx = get(b->ngX), gy = get(b->ngY), gz = get(b->ngZ);
     // A zero (or overflowing) interpolated normal keeps the face normal.
-    const auto useAuthored = hn::And(hn::Gt(hn::Load(d, b->authored + i), zero),
-                                     hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
+    const auto useAuthored =
+        hn::And(hn::Gt(get(b->authored), zero), hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
     const auto side = hn::Load(d, b->side + i);
     const auto fx = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sx, length), gx));
     const auto fy = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sy, length), gy));
@@ -228,7 +245,7 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto invPi = hn::Set(d, eyeLight ? 1.0f : float(0.31830988618379067154));
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto diffuse = hn::Load(d, b->diffuseWeight + i);
+    const auto diffuse = RunValue(d, b, i, b->diffuseWeight);
     const auto hasDiffuse = hn::Gt(diffuse, zero);
     const auto alpha = hn::Load(d, b->alpha + i);
     const auto channel = [&](const float* albedo, const float* sum, const float* emit, float* out) {
@@ -246,48 +263,29 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
 
 size_t RefineLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
-// intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp}),
-// operation for operation: glm's cross (x.y·y.z − y.y·x.z, ...) and dot
-// ((x + y) + z), the canonical slots mapped back, the plane kept only ahead
-// of the ray, the clamp max(b, 0) as glm's (b < 0 ? 0 : b), then the scale
-// onto the edge v1–v2.
+// intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp})
+// per lane: common/primary_refinement-inl.h, with s = origin − a,
+// q = s × e1 and e2 · q computed per lane as the scalar memo computes them.
 void LanesRefine(kernel_detail::RefineBlock* b) {
   const hn::ScalableTag<double> d;
   const size_t N = hn::Lanes(d);
-  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  const auto one = hn::Set(d, 1.0);
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto dx = hn::Load(d, b->dx + i), dy = hn::Load(d, b->dy + i), dz = hn::Load(d, b->dz + i);
-    const auto e1x = hn::Load(d, b->e1x + i), e1y = hn::Load(d, b->e1y + i), e1z = hn::Load(d, b->e1z + i);
-    const auto e2x = hn::Load(d, b->e2x + i), e2y = hn::Load(d, b->e2y + i), e2z = hn::Load(d, b->e2z + i);
-    // p = direction × e2
-    const auto px = hn::Sub(hn::Mul(dy, e2z), hn::Mul(e2y, dz));
-    const auto py = hn::Sub(hn::Mul(dz, e2x), hn::Mul(e2z, dx));
-    const auto pz = hn::Sub(hn::Mul(dx, e2y), hn::Mul(e2x, dy));
-    const auto det = hn::Add(hn::Add(hn::Mul(e1x, px), hn::Mul(e1y, py)), hn::Mul(e1z, pz));
-    auto ok = hn::Gt(hn::Abs(det), zero);
-    const auto inv = hn::Div(one, det);
+    RefinePlaneLanes<hn::Vec<decltype(d)>> pl;
+    pl.e1x = hn::Load(d, b->e1x + i), pl.e1y = hn::Load(d, b->e1y + i), pl.e1z = hn::Load(d, b->e1z + i);
+    pl.e2x = hn::Load(d, b->e2x + i), pl.e2y = hn::Load(d, b->e2y + i), pl.e2z = hn::Load(d, b->e2z + i);
     // s = origin − a, q = s × e1
-    const auto sx = hn::Sub(hn::Load(d, b->ox + i), hn::Load(d, b->ax + i));
-    const auto sy = hn::Sub(hn::Load(d, b->oy + i), hn::Load(d, b->ay + i));
-    const auto sz = hn::Sub(hn::Load(d, b->oz + i), hn::Load(d, b->az + i));
-    const auto u = hn::Mul(hn::Add(hn::Add(hn::Mul(sx, px), hn::Mul(sy, py)), hn::Mul(sz, pz)), inv);
-    const auto qx = hn::Sub(hn::Mul(sy, e1z), hn::Mul(e1y, sz));
-    const auto qy = hn::Sub(hn::Mul(sz, e1x), hn::Mul(e1z, sx));
-    const auto qz = hn::Sub(hn::Mul(sx, e1y), hn::Mul(e1x, sy));
-    const auto w = hn::Mul(hn::Add(hn::Add(hn::Mul(dx, qx), hn::Mul(dy, qy)), hn::Mul(dz, qz)), inv);
-    const auto t = hn::Mul(hn::Add(hn::Add(hn::Mul(e2x, qx), hn::Mul(e2y, qy)), hn::Mul(e2z, qz)), inv);
-    ok = hn::And(ok, hn::And(hn::IsFinite(t), hn::And(hn::IsFinite(u), hn::IsFinite(w))));
-    const auto w0 = hn::Sub(hn::Sub(one, u), w);
-    const auto s1 = hn::Load(d, b->slot1 + i), s2 = hn::Load(d, b->slot2 + i);
-    auto b1 = hn::IfThenElse(hn::Eq(s1, zero), w0, hn::IfThenElse(hn::Eq(s1, one), u, w));
-    auto b2 = hn::IfThenElse(hn::Eq(s2, zero), w0, hn::IfThenElse(hn::Eq(s2, one), u, w));
-    ok = hn::And(ok, hn::And(hn::Gt(t, zero), hn::IsFinite(hn::Mul(t, hn::Load(d, b->depthPerT + i)))));
-    b1 = hn::IfThenElse(hn::Lt(b1, zero), zero, b1);
-    b2 = hn::IfThenElse(hn::Lt(b2, zero), zero, b2);
-    const auto sum = hn::Add(b1, b2);
-    const auto over = hn::Gt(sum, one);
-    b1 = hn::IfThenElse(over, hn::Div(b1, sum), b1);
-    b2 = hn::IfThenElse(over, hn::Div(b2, sum), b2);
+    pl.sx = hn::Sub(hn::Load(d, b->ox + i), hn::Load(d, b->ax + i));
+    pl.sy = hn::Sub(hn::Load(d, b->oy + i), hn::Load(d, b->ay + i));
+    pl.sz = hn::Sub(hn::Load(d, b->oz + i), hn::Load(d, b->az + i));
+    pl.qx = hn::Sub(hn::Mul(pl.sy, pl.e1z), hn::Mul(pl.e1y, pl.sz));
+    pl.qy = hn::Sub(hn::Mul(pl.sz, pl.e1x), hn::Mul(pl.e1z, pl.sx));
+    pl.qz = hn::Sub(hn::Mul(pl.sx, pl.e1y), hn::Mul(pl.e1x, pl.sy));
+    pl.e2DotQ = hn::Add(hn::Add(hn::Mul(pl.e2x, pl.qx), hn::Mul(pl.e2y, pl.qy)), hn::Mul(pl.e2z, pl.qz));
+    pl.slot1 = hn::Load(d, b->slot1 + i), pl.slot2 = hn::Load(d, b->slot2 + i);
+    hn::Vec<decltype(d)> b1, b2;
+    const auto ok = RefineOnPlane(d, hn::Load(d, b->dx + i), hn::Load(d, b->dy + i), hn::Load(d, b->dz + i),
+                                  hn::Load(d, b->depthPerT + i), pl, &b1, &b2);
     hn::Store(b1, d, b->b1 + i);
     hn::Store(b2, d, b->b2 + i);
     hn::Store(hn::IfThenElseZero(ok, one), d, b->refined + i);
@@ -410,7 +408,21 @@ class BlockShader {
     outputs_[i] = out;
     // Consecutive hits mostly share a triangle: its data is looked up once
     // per run (the same values, so the lane does not depend on the run).
-    if (h.instance != run_.instance || h.triangle != run_.triangle) startRun(h.instance, h.triangle);
+    const bool newTriangle = h.instance != run_.instance || h.triangle != run_.triangle;
+    if (newTriangle) startRun(h.instance, h.triangle);
+    if (newTriangle || b.runs == 0) {
+      // The run's entry in the block's table.
+      const size_t r = b.runs++;
+      b.ngX[r] = run_.ngF.x;
+      b.ngY[r] = run_.ngF.y;
+      b.ngZ[r] = run_.ngF.z;
+      b.authored[r] = run_.authored ? 1.0f : 0.0f;
+      b.n0X[r] = run_.n0.x, b.n0Y[r] = run_.n0.y, b.n0Z[r] = run_.n0.z;
+      b.n1X[r] = run_.n1.x, b.n1Y[r] = run_.n1.y, b.n1Z[r] = run_.n1.z;
+      b.n2X[r] = run_.n2.x, b.n2Y[r] = run_.n2.y, b.n2Z[r] = run_.n2.z;
+      b.diffuseWeight[r] = (1.0f - m.mirrorWeight()) * (1.0f - m.transmission);
+    }
+    b.run[i] = int32_t(b.runs - 1);
     const Instance& inst = *run_.inst;
     const glm::uvec3 t = run_.corners;
     const double b0 = 1.0 - double(h.b1) - double(h.b2);
@@ -418,19 +430,12 @@ class BlockShader {
     // makeSurfacePoint and Shader::shade decide it.
     const bool entering = isEntering(h.direction, run_.ng);
     b.side[i] = entering ? 1.0f : -1.0f;
-    b.ngX[i] = run_.ngF.x;
-    b.ngY[i] = run_.ngF.y;
-    b.ngZ[i] = run_.ngF.z;
     b.dirX[i] = float(h.direction.x);
     b.dirY[i] = float(h.direction.y);
     b.dirZ[i] = float(h.direction.z);
     b.b0[i] = float(b0);
     b.b1[i] = h.b1;
     b.b2[i] = h.b2;
-    b.authored[i] = run_.authored ? 1.0f : 0.0f;
-    b.n0X[i] = run_.n0.x, b.n0Y[i] = run_.n0.y, b.n0Z[i] = run_.n0.z;
-    b.n1X[i] = run_.n1.x, b.n1Y[i] = run_.n1.y, b.n1Z[i] = run_.n1.z;
-    b.n2X[i] = run_.n2.x, b.n2Y[i] = run_.n2.y, b.n2Z[i] = run_.n2.z;
 
     // Base colour and emission: Shader::baseColor and emission's float
     // steps, here with the textures sampled through the pixel footprint.
@@ -458,8 +463,6 @@ class BlockShader {
     b.emitR[i] = emit.r;
     b.emitG[i] = emit.g;
     b.emitB[i] = emit.b;
-    const float w = m.mirrorWeight();
-    b.diffuseWeight[i] = (1.0f - w) * (1.0f - m.transmission);
     b.alpha[i] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
     if (!shader_.eyeLight()) positions_[i] = b0 * run_.p0 + double(h.b1) * run_.p1 + double(h.b2) * run_.p2;
   }
@@ -511,6 +514,7 @@ class BlockShader {
     HWY_DYNAMIC_DISPATCH(LanesFinish)(&b, eyeLight);
     for (size_t i = 0; i < b.used; ++i) *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
     b.used = 0;
+    b.runs = 0;
   }
 
  private:
@@ -546,7 +550,8 @@ class BlockShader {
   }
 
   // Fills the lanes from `used` to a whole number of vectors with a
-  // harmless surface (unit normals, no light, no colour), never read back.
+  // harmless surface (the last run's normals, no light, no colour), never
+  // read back.
   void padLanes() {
     LaneBlock& b = block_;
     b.lanes = (b.used + vectorLanes_ - 1) / vectorLanes_ * vectorLanes_;
@@ -554,15 +559,11 @@ class BlockShader {
       b.dirX[i] = b.dirY[i] = 0.0f;
       b.dirZ[i] = -1.0f;
       b.side[i] = 1.0f;
-      b.ngX[i] = b.ngY[i] = 0.0f;
-      b.ngZ[i] = 1.0f;
-      b.authored[i] = 0.0f;
+      b.run[i] = int32_t(b.runs - 1);  // the last run's normals; no colour below
       b.b0[i] = 1.0f;
       b.b1[i] = b.b2[i] = 0.0f;
-      b.n0X[i] = b.n0Y[i] = b.n0Z[i] = b.n1X[i] = b.n1Y[i] = b.n1Z[i] = b.n2X[i] = b.n2Y[i] = b.n2Z[i] = 0.0f;
       b.albedoR[i] = b.albedoG[i] = b.albedoB[i] = 0.0f;
       b.emitR[i] = b.emitG[i] = b.emitB[i] = 0.0f;
-      b.diffuseWeight[i] = 0.0f;
       b.alpha[i] = 1.0f;
       b.toLightX[i] = b.toLightY[i] = 0.0f;
       b.toLightZ[i] = 1.0f;
@@ -584,26 +585,41 @@ class BlockShader {
 }  // namespace
 
 void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,
-                      ShadingPath path) {
+                      const uint32_t* colorIndex, ShadingPath path) {
+  const auto out = [&](size_t i) -> glm::vec4& { return colors[colorIndex ? colorIndex[i] : i]; };
   if (path == ShadingPath::Reference || shader.options().referenceShading) {
-    for (size_t i = 0; i < count; ++i) colors[i] = shadeReference(shader, hits[i]);
+    for (size_t i = 0; i < count; ++i) out(i) = shadeReference(shader, hits[i]);
     return;
   }
   // Built at the first lane: a batch of scalar-path hits (a BLEND layer)
   // needs none of it.
   std::optional<BlockShader> block;
+  // The path is a function of the material: decided once per run of hits
+  // on one instance.
+  uint32_t runInstance = kNoId;
+  const Material* material = nullptr;
+  bool scalar = false;
   for (size_t i = 0; i < count; ++i) {
     const ShadeHit& h = hits[i];
-    const Material& m = shader.scene().materialOf(h.instance);
-    if (needsScalarShade(shader, m)) {
-      colors[i] = shadeReference(shader, h);
+    if (h.instance != runInstance) {
+      runInstance = h.instance;
+      material = &shader.scene().materialOf(h.instance);
+      scalar = needsScalarShade(shader, *material);
+    }
+    if (scalar) {
+      out(i) = shadeReference(shader, h);
       continue;
     }
     if (!block) block.emplace(shader);
-    block->add(h, m, &colors[i]);
+    block->add(h, *material, &out(i));
     if (block->full()) block->run();
   }
   if (block) block->run();
+}
+
+void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,
+                      ShadingPath path) {
+  shadePrimaryHits(shader, hits, count, colors, nullptr, path);
 }
 
 void refinePrimaryHits(const Scene& scene, const Ray* rays, const SampleHit* hits,

@@ -106,6 +106,11 @@ enum class ShadingPath {
 void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,
                       ShadingPath path);
 
+// The same, scattered: the colour of hits[i] into colors[colorIndex[i]]
+// (a tile's samples, without a contiguous copy in between).
+void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,
+                      const uint32_t* colorIndex, ShadingPath path);
+
 // The SIMD target HWY_DYNAMIC_DISPATCH runs the lanes on here (Highway's
 // name: AVX3, AVX2, SSE4, ...), for reports and tests.
 const char* shadingKernelTarget();

@@ -28,89 +28,106 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
                                 ThreadCounters& n) const {
   const TileRect& rect = index.rect;
   const int spp = grid_.spp;
-  samples.color.assign(index.count(), glm::vec4(0.0f));
-  samples.front.assign(index.count(), SampleHit{});
-  // The tile's winning samples in three steps: gather the hits to shade
-  // with their primary rays (in pixel and sample order), refine them on
-  // their planes as one batch (common/primary_refinement.h), then shade
-  // them as one batch through the shading kernel (common/shading_kernel.h),
-  // the one the ray caster shades its primary hits with. Each sample takes the
-  // colour of the hit it shaded or, at shading rate pixel, of the first
+  // Every sample is written exactly once below (a background sample in the
+  // winner loop, a winner's hit and colour after the batch), so the
+  // storage is only sized, never filled first.
+  samples.color.resize(index.count());
+  samples.front.resize(index.count());
+  // The tile's winning samples in two steps, a chunk of them at a time:
+  // gather the hits to shade (in pixel and sample order) and compute, per
+  // block of them in double lanes, the interpolated hit, the primary ray
+  // and the hit refined on its stored triangle's plane (primaryShadeHits:
+  // primarySamples' and refinePrimaryHits' bits, raster/primary_samples.h);
+  // then shade them through the shading kernel (common/shading_kernel.h),
+  // the one the ray caster shades its primary hits with, straight into the
+  // tile's colours. A hit's colour does not depend on its chunk (the
+  // kernel's lane independence). At shading rate pixel a sample takes the colour of the first
   // sample of its pixel on the same triangle. Per-thread scratch: no
   // allocation per tile once grown.
   struct Assignment {
-    uint32_t local;    // TileSampleIndex
-    uint32_t request;  // index into `requests`
+    uint32_t local;   // TileSampleIndex
+    uint32_t source;  // the sample whose colour it takes
   };
   thread_local std::vector<uint32_t> winners;       // setup per request
   thread_local std::vector<glm::dvec2> positions;   // image position per request
   thread_local std::vector<uint32_t> requestLocal;  // the sample a request is shaded at
   thread_local std::vector<SampleHit> hits;         // interpolated, per request
-  thread_local std::vector<Ray> rays;               // primary ray through the sample, per request
   thread_local std::vector<glm::dvec2> footprints;  // image position of the texture footprint
-  thread_local std::vector<ShadeHit> requests;      // refined (refinePrimaryHits)
-  thread_local std::vector<glm::vec4> colors;
+  thread_local std::vector<ShadeHit> requests;      // refined
   thread_local std::vector<Assignment> assignments;
-  winners.clear();
-  positions.clear();
-  requestLocal.clear();
-  footprints.clear();
+  // Requests are shaded a chunk at a time as the loop gathers them, so a
+  // chunk's inputs, hits and refined requests stay in the core's caches
+  // (a whole tile's would not: about 0.7 MB at 1 spp). Sized once, filled
+  // through plain pointers (no push_back in the sample loop).
+  constexpr size_t kChunk = 256;
+  for (auto* v : {&winners, &requestLocal}) v->resize(kChunk);
+  for (auto* v : {&positions, &footprints}) v->resize(kChunk);
+  hits.resize(kChunk);
+  requests.resize(kChunk);
+  uint32_t* const winnerOut = winners.data();
+  uint32_t* const localOut = requestLocal.data();
+  glm::dvec2* const positionOut = positions.data();
+  glm::dvec2* const footprintOut = footprints.data();
+  size_t count = 0;
   assignments.clear();
+  // The chunk's hits into the tile's samples, then its colours.
+  const auto flush = [&] {
+    primaryShadeHits(primaryConstants_, scene_, setups_.data(), winnerOut, positionOut, footprintOut, count,
+                     hits.data(), requests.data());
+    for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = hits[r];
+    shadePrimaryHits(shader_, requests.data(), count, samples.color.data(), localOut, shadingPath());
+    n.shadedSamples += count;
+    count = 0;
+  };
   const auto addRequest = [&](uint32_t win, uint32_t local, const glm::dvec2& pos,
                               const glm::dvec2& footprint) {
-    winners.push_back(win);
-    positions.push_back(pos);
-    requestLocal.push_back(local);
-    footprints.push_back(footprint);
-    return uint32_t(winners.size() - 1);
+    winnerOut[count] = win;
+    localOut[count] = local;
+    positionOut[count] = pos;
+    footprintOut[count] = footprint;
+    if (++count == kChunk) flush();
   };
-  std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, request)
-  for (int py = rect.y0; py < rect.y1; ++py)
+  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
+  std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, local)
+  for (int py = rect.y0; py < rect.y1; ++py) {
+    // The row's samples are consecutive in both the target and the tile.
+    const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
+    uint32_t local = index(rect.x0, py, 0);
     for (int px = rect.x0; px < rect.x1; ++px) {
       pixelCache.clear();
       const glm::dvec2 corner(px, py);
       const bool traced = trace.sink && px == trace.pixel.x && py == trace.pixel.y;
-      for (int s = 0; s < spp; ++s) {
-        const uint32_t win = target.winners[target.index(px, py, s)];
-        if (win == kNoSetup) continue;
-        const uint32_t local = index(px, py, s);
-        const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
-        uint32_t request;
-        if (options_.shadingRate == ShadingRate::Pixel) {
-          const TriangleSetup& t = setups_[win];
-          auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
-                                 [&](const auto& e) { return e.first == t.id(); });
-          if (it != pixelCache.end()) {
-            request = it->second;
-            // The sample's own hit only where someone reads it: the
-            // resolve's centre sample, the per-sample hits, the trace.
-            if (allFronts || s == centre_ || traced) samples.front[local] = interpolatedHit(t, pos);
-          } else {
-            // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
-            request = addRequest(win, local, pos, corner + glm::dvec2(0.5));
-            pixelCache.emplace_back(t.id(), request);
-          }
-        } else {
-          request = addRequest(win, local, pos, pos);
+      for (int s = 0; s < spp; ++s, ++local) {
+        const uint32_t win = *rowWinners++;
+        if (win == kNoSetup) {
+          samples.color[local] = glm::vec4(0.0f);
+          samples.front[local] = SampleHit{};
+          continue;
         }
-        assignments.push_back({local, request});
+        const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
+        if (!pixelRate) {
+          addRequest(win, local, pos, pos);
+          continue;
+        }
+        const TriangleSetup& t = setups_[win];
+        auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
+                               [&](const auto& e) { return e.first == t.id(); });
+        if (it != pixelCache.end()) {
+          assignments.push_back({local, it->second});
+          // The sample's own hit only where someone reads it: the
+          // resolve's centre sample, the per-sample hits, the trace.
+          samples.front[local] = allFronts || s == centre_ || traced ? interpolatedHit(t, pos) : SampleHit{};
+        } else {
+          // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
+          addRequest(win, local, pos, corner + glm::dvec2(0.5));
+          pixelCache.emplace_back(t.id(), local);
+        }
       }
     }
-  // Each request's interpolated hit and primary ray in double lanes
-  // (interpolatedHit's and PrimaryRays' bits: raster/primary_samples.h).
-  const size_t count = winners.size();
-  hits.resize(count);
-  rays.resize(count);
-  primarySamples(primaryConstants_, setups_.data(), winners.data(), positions.data(), count, hits.data(),
-                 rays.data());
-  for (size_t r = 0; r < count; ++r) samples.front[requestLocal[r]] = hits[r];
-  // Refined on their planes in double lanes (refinePrimaryHit's bits).
-  requests.resize(hits.size());
-  refinePrimaryHits(scene_, rays.data(), hits.data(), footprints.data(), hits.size(), requests.data());
-  colors.resize(requests.size());
-  shadePrimaryHits(shader_, requests.data(), requests.size(), colors.data(), shadingPath());
-  n.shadedSamples += requests.size();
-  for (const Assignment& a : assignments) samples.color[a.local] = colors[a.request];
+  }
+  if (count > 0) flush();
+  // After every chunk: a source sample's colour is final.
+  for (const Assignment& a : assignments) samples.color[a.local] = samples.color[a.source];
 
   if (trace.sink && trace.pixel.x >= rect.x0 && trace.pixel.x < rect.x1 && trace.pixel.y >= rect.y0 &&
       trace.pixel.y < rect.y1) {

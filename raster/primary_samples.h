@@ -17,6 +17,8 @@
 
 #include "common/camera.h"
 #include "common/hit.h"
+#include "common/scene.h"
+#include "common/shading_kernel.h"
 #include "raster/setup.h"
 
 namespace rastray {
@@ -43,6 +45,18 @@ void primarySamples(const PrimaryRayConstants& camera, const TriangleSetup* setu
 void primarySamplesReference(const PrimaryRayConstants& camera, const TriangleSetup* setups,
                              const uint32_t* winners, const glm::dvec2* positions, size_t count,
                              SampleHit* hits, Ray* rays);
+
+// The deferred shading's inputs in one pass: hits[i] as primarySamples
+// gives them, and out[i] = refinePrimaryHit(scene, ray_i, hits[i],
+// footprints[i]) with ray_i = PrimaryRays(camera)(positions[i]), as
+// refinePrimaryHits would give it, bit for bit. For a perspective camera
+// each block of samples is gathered once (the setup's planes and the
+// stored triangle's plane, looked up once per run of samples on one
+// triangle) and runs interpolation, primary ray and refinement in the same
+// double lanes, without materialising the rays; otherwise the two calls.
+void primaryShadeHits(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
+                      const uint32_t* winners, const glm::dvec2* positions, const glm::dvec2* footprints,
+                      size_t count, SampleHit* hits, ShadeHit* out);
 
 // TileRenderer::interpolatedHit: depth and barycentrics at `pos` from the
 // setup's planes, rounded to float.

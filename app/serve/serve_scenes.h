@@ -29,6 +29,7 @@
 #include "app/engine/render_setup.h"
 #include "common/memory_budget.h"
 #include "common/scene.h"
+#include "raster/frame_buffers.h"
 
 namespace rastray::serve {
 
@@ -84,6 +85,11 @@ class LruCache {
 struct PreparedFrame {
   std::shared_ptr<const Scene> scene;
   RenderSettings settings;
+  // The rasterizer's depth target and image storage, kept between this
+  // frame's requests (raster.frameBuffers points here; the image comes
+  // back through recycle() once encoded). Declared before `raster` and the
+  // renderer, so it outlives both.
+  RasterFrameBuffers buffers;
   RasterOptions raster;
   RayOptions ray;
   std::unique_ptr<FrameRenderer> renderer;

@@ -170,6 +170,22 @@ TEST_F(ServeTest, PreparedRendererIsKeptBetweenRequests) {
   EXPECT_EQ(a["image"], b["image"]);
 }
 
+// A prepared raster frame keeps its depth target and image storage
+// between requests (PreparedFrame::buffers): the next request renders into
+// the last one's stale storage and must give the same picture, at 1 and 4
+// samples per pixel and at a size that is no multiple of the tile.
+TEST_F(ServeTest, RasterPreviewsReuseTheirBuffersAndKeepThePicture) {
+  for (const char* spp : {"1", "4"}) {
+    const std::string target = "/api/frame?" + cornell() + "&size=130,67&renderer=raster&spp=" + spp;
+    const auto first = get(target), second = get(target), third = get(target);
+    ASSERT_TRUE(first && second && third);
+    ASSERT_EQ(first->status, 200) << first->body;
+    const json a = json::parse(first->body), b = json::parse(second->body), c = json::parse(third->body);
+    EXPECT_EQ(a["image"], b["image"]) << spp;
+    EXPECT_EQ(a["image"], c["image"]) << spp;
+  }
+}
+
 // The BVH depends on the rebased scene and the culling mode only: changing
 // spp or the shadow method keeps it, and so does moving the camera under
 // --origin world; moving the eye under --origin camera (the default)

@@ -7,6 +7,8 @@
 #include <string>
 #include <thread>
 
+#include <tbb/task_arena.h>
+
 #include "common/gltf/loader.h"
 #include "raster/frame_buffers.h"
 #include "raster_test_util.h"
@@ -111,6 +113,57 @@ TEST(FrameBuffers, BusyPoolFallsBackToOwnBuffers) {
   pooled.frameBuffers = &pool;
   const RenderOutput busy = test::render(triangle, camera, pooled);
   expectSameImage(busy.image, fresh.image, "busy pool");
+}
+
+// The tile's samples (per-thread scratch, raster/tile_renderer.cpp) are
+// sized, not filled, before each tile: the deferred shading writes every
+// sample once, background included. On one thread (a task arena of one,
+// so the tile order and the scratch are the same each time) a small
+// triangle, whose tiles are mostly background, is rendered after two
+// different frames that leave different samples behind: the pictures,
+// ids and per-sample hits must not differ, at both shading rates.
+TEST(FrameBuffers, TileSamplesLeftByAnotherFrameDoNotShow) {
+  const Scene cornell = loadScene(test::scenePath("cornell-box.gltf"));
+  Scene quad;
+  test::addMesh(quad,
+                {{-5.0f, -5.0f, -2.0f}, {5.0f, -5.0f, -2.0f}, {5.0f, 5.0f, -2.0f}, {-5.0f, 5.0f, -2.0f}},
+                {{0, 1, 2}, {0, 2, 3}}, test::colored(glm::vec4(0.9f, 0.1f, 0.3f, 1.0f)));
+  Scene small;
+  test::addMesh(small, {{-0.2f, -0.2f, -2.0f}, {0.2f, -0.2f, -2.0f}, {0.0f, 0.2f, -2.0f}}, {{0, 1, 2}},
+                test::colored(glm::vec4(0.2f, 0.6f, 0.9f, 1.0f)));
+  const Camera camera = test::orthoCamera(192, 1.0);
+  tbb::task_arena one(1);
+  for (const int spp : {1, 4}) {
+    for (const ShadingRate rate : {ShadingRate::Sample, ShadingRate::Pixel}) {
+      const std::string what =
+          "spp " + std::to_string(spp) + (rate == ShadingRate::Pixel ? " pixel" : " sample");
+      RasterOptions options;
+      options.spp = spp;
+      options.shadingRate = rate;
+      options.shadows = ShadowMode::None;
+      RenderOutput after[2];
+      std::vector<SampleHit> hits[2];
+      for (int k = 0; k < 2; ++k) {
+        one.execute([&] {
+          const Scene& before = k == 0 ? cornell : quad;
+          test::render(before, k == 0 ? makeCamera(cornell, {}, 192, 192) : camera, options);
+          after[k] = renderRasterWithHits(small, analyzeScene(small), camera, options, &hits[k]);
+        });
+      }
+      expectSameImage(after[0].image, after[1].image, what);
+      ASSERT_EQ(hits[0].size(), hits[1].size()) << what;
+      EXPECT_EQ(0, std::memcmp(hits[0].data(), hits[1].data(), hits[0].size() * sizeof(SampleHit))) << what;
+      // And the background is background (at 1 spp a pixel is its sample;
+      // at 4 an edge pixel's centre may miss while other samples hit).
+      size_t background = 0;
+      for (size_t i = 0; i < after[0].image.instance.size(); ++i) {
+        if (spp != 1 || after[0].image.instance[i] != kNoId) continue;
+        ++background;
+        EXPECT_EQ(after[0].image.color[i], glm::vec4(0.0f)) << what << " pixel " << i;
+      }
+      if (spp == 1) EXPECT_GT(background, after[0].image.instance.size() / 2) << what;
+    }
+  }
 }
 
 }  // namespace

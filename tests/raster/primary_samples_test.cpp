@@ -113,5 +113,119 @@ TEST(PrimarySamples, LanesGiveTheReferenceBitsOnEveryTarget) {
   }
 }
 
+// Random triangles around `centre` (some degenerate, some slivers), each
+// with its own corners, one instance: stored planes the primary rays meet
+// ahead, behind and nearly edge-on.
+Scene trianglesAround(std::mt19937& rng, const glm::dvec3& centre, double size) {
+  Scene s;
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto near = [&] { return glm::vec3(centre + size * glm::dvec3(unit(rng), unit(rng), unit(rng))); };
+  for (uint32_t i = 0; i < 40; ++i) {
+    const glm::vec3 p0 = near(), p1 = near();
+    const glm::vec3 p2 = i % 7 == 0 ? p0 : i % 5 == 0 ? p1 + 1e-6f * (near() - p1) : near();
+    const uint32_t first = uint32_t(s.positions.size());
+    for (const glm::vec3& p : {p0, p1, p2}) {
+      s.positions.push_back(p);
+      s.normals.push_back(glm::vec3(0.0f));
+      s.texcoords.push_back(glm::vec2(0.0f));
+    }
+    s.triangles.push_back({first, first + 1, first + 2});
+  }
+  Instance inst;
+  inst.vertexCount = uint32_t(s.positions.size());
+  inst.triangleCount = uint32_t(s.triangles.size());
+  s.instances.push_back(inst);
+  s.materials.push_back(Material{});
+  return s;
+}
+
+bool sameBits(const ShadeHit& a, const ShadeHit& b) {
+  return a.instance == b.instance && a.triangle == b.triangle && std::memcmp(&a.b1, &b.b1, 4) == 0 &&
+         std::memcmp(&a.b2, &b.b2, 4) == 0 &&
+         std::memcmp(&a.direction, &b.direction, sizeof a.direction) == 0 &&
+         a.footprintPosition == b.footprintPosition && a.throughput == b.throughput;
+}
+
+// primaryShadeHits, the rasterizer's fused pass (interpolation, primary ray
+// and refinement in one pass of lanes per block), against the two steps it
+// replaces: primarySamplesReference, then refinePrimaryHit on each ray.
+TEST(PrimarySamples, FusedPassGivesTheTwoStepsBitsOnEveryTarget) {
+  std::mt19937 rng(9);
+  struct Case {
+    std::string name;
+    Camera camera;
+    glm::dvec3 centre;
+    double size;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"1920x1080 60deg",
+                   test::perspectiveCamera(1920, 1080, 1.047, {0.3, 0.2, 4.0}, {0, 0, 0}),
+                   {0, 0, 0},
+                   1.5});
+  cases.push_back({"97x61 far eye",
+                   test::perspectiveCamera(97, 61, 0.7, {1e6, -3e5, 2e6}, {1e6 + 1, -3e5, 0}),
+                   {1e6, -3e5, 1e6},
+                   3e5});
+  cases.push_back({"333x777 wide, triangles around the eye",
+                   test::perspectiveCamera(333, 777, 2.9, {-2, 1, 1}, {3, 2, -7}),
+                   {-2, 1, 1},
+                   2.0});
+  cases.push_back({"orthographic", test::orthoCamera(128, 3.0), {0, 0, 0}, 2.0});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const int w = c.camera.width, h = c.camera.height;
+    const Scene scene = trianglesAround(rng, c.centre, c.size);
+    std::vector<TriangleSetup> setups = randomSetups(rng, w, h);
+    for (size_t i = 0; i < setups.size(); ++i) {
+      setups[i].instance = 0;
+      setups[i].triangle = uint32_t(i % scene.triangles.size());
+    }
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<uint32_t> winners;
+    std::vector<glm::dvec2> positions, footprints;
+    for (int k = 0; k < 3001; ++k) {
+      // Long runs on one setup (whole vectors of lanes on one run: the
+      // broadcast path), then runs of 1 and 7 mixed (the gather path).
+      winners.push_back(k < 1500 ? uint32_t((k / 23) % setups.size())
+                                 : uint32_t((k / (k % 2 ? 1 : 7)) % setups.size()));
+      positions.push_back(k % 11 == 0 ? glm::dvec2(k % w, (k / w) % h) + 0.5
+                                      : glm::dvec2(u(rng) * w, u(rng) * h));
+      footprints.push_back(k % 3 == 0 ? positions.back() : glm::dvec2(k % w, k % h) + 0.5);
+    }
+    const size_t n = winners.size();
+    const PrimaryRayConstants constants(c.camera);
+    std::vector<SampleHit> expectedHits(n);
+    std::vector<Ray> rays(n);
+    primarySamplesReference(constants, setups.data(), winners.data(), positions.data(), n,
+                            expectedHits.data(), rays.data());
+    std::vector<ShadeHit> expected(n);
+    size_t refined = 0;
+    for (size_t i = 0; i < n; ++i) {
+      expected[i] = refinePrimaryHit(scene, rays[i], expectedHits[i], footprints[i]);
+      refined += expected[i].b1 != expectedHits[i].b1 || expected[i].b2 != expectedHits[i].b2;
+    }
+    // Both outcomes occur: refined on the plane, and kept (degenerate,
+    // behind the eye).
+    EXPECT_GT(refined, n / 4);
+    EXPECT_LT(refined, n);
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      SCOPED_TRACE(hwy::TargetName(target));
+      hwy::SetSupportedTargetsForTest(target);
+      for (size_t batch : {size_t(1), size_t(5), size_t(64), size_t(100), n}) {
+        std::vector<SampleHit> hits(n);
+        std::vector<ShadeHit> out(n);
+        for (size_t first = 0; first < n; first += batch)
+          primaryShadeHits(constants, scene, setups.data(), &winners[first], &positions[first],
+                           &footprints[first], std::min(batch, n - first), &hits[first], &out[first]);
+        for (size_t i = 0; i < n; ++i) {
+          ASSERT_TRUE(sameBits(hits[i], expectedHits[i])) << "batch " << batch << " sample " << i;
+          ASSERT_TRUE(sameBits(out[i], expected[i])) << "batch " << batch << " sample " << i;
+        }
+      }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+  }
+}
+
 }  // namespace
 }  // namespace rastray
