@@ -53,6 +53,17 @@ std::vector<Camera> cubeFaceCameras(const glm::dvec3& eye, int size, double znea
 // candidates and the maps stay identical.
 std::vector<uint8_t> cubeFaceCandidates(const Scene& scene, const glm::dvec3& eye, double t, int size);
 
+// One texel of light `lightIndex`'s map (maps of `size` texels a side, as
+// ShadowMaps renders them) near `point`: its two sides as world vectors
+// across the light (a directional map's are uniform; a cube face's or
+// spot map's at the point's depth along the face's axis). A one-texel
+// lookup cannot place a shadow edge closer than this; the stability study
+// uses it to tell the maps' resolution from their bias.
+struct ShadowTexel {
+  glm::dvec3 side[2];
+};
+ShadowTexel shadowMapTexel(const Scene& scene, int lightIndex, int size, const glm::dvec3& point);
+
 class ShadowMaps : public LightVisibility {
  public:
   // Renders the maps of every light (none without lights). `shader`
@@ -65,18 +76,21 @@ class ShadowMaps : public LightVisibility {
   glm::vec3 transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
                           double distance) const override;
 
-  // The transmittance of light `lightIndex` at `world`, `toLight` the
-  // direction from the point towards the light (it picks the cube face):
-  // what transmittance() returns for a point at `world`. Plain members,
-  // not virtual, for callers that shade many points at once: the batch
-  // form looks up n points of one light.
-  glm::vec3 lightTransmittance(int lightIndex, const glm::dvec3& world, const glm::dvec3& toLight) const;
-  void lightTransmittances(int lightIndex, size_t n, const glm::dvec3* world, const glm::dvec3* toLight,
-                           glm::vec3* out) const;
+  // The transmittance of light `lightIndex` at `world` on a surface of
+  // unit geometric normal `normal` (either side; zero: compare the point's
+  // own depth, no receiver plane), `toLight` the direction from the point
+  // towards the light (it picks the cube face): what transmittance()
+  // returns for that surface point. Plain members, not virtual, for
+  // callers that shade many points at once: the batch form looks up n
+  // points of one light.
+  glm::vec3 lightTransmittance(int lightIndex, const glm::dvec3& world, const glm::dvec3& normal,
+                               const glm::dvec3& toLight) const;
+  void lightTransmittances(int lightIndex, size_t n, const glm::dvec3* world, const glm::dvec3* normal,
+                           const glm::dvec3* toLight, glm::vec3* out) const;
   // The same from the scalar reference lookup: the general matrix and
   // window-depth functions, and a binary search of the map tile's
   // attenuating fragments. The tests demand the same bits.
-  glm::vec3 lightTransmittanceReference(int lightIndex, const glm::dvec3& world,
+  glm::vec3 lightTransmittanceReference(int lightIndex, const glm::dvec3& world, const glm::dvec3& normal,
                                         const glm::dvec3& toLight) const;
 
   uint64_t trianglesRendered() const { return triangles_; }
@@ -99,6 +113,7 @@ class ShadowMaps : public LightVisibility {
     double width = 0.0, height = 0.0;
     bool perspective = true;
     double znear = 0.0, zfar = 0.0;
+    glm::dvec2 sample{0.5};  // a texel's sample position within it
   };
   struct Map {
     Camera camera;
@@ -119,8 +134,8 @@ class ShadowMaps : public LightVisibility {
   const Map& mapAt(size_t i) const;
 
  private:
-  glm::vec3 lit(const Map& map, const glm::dvec3& world) const;
-  glm::vec3 litReference(const Map& map, const glm::dvec3& world) const;
+  glm::vec3 lit(const Map& map, const glm::dvec3& world, const glm::dvec3& normal) const;
+  glm::vec3 litReference(const Map& map, const glm::dvec3& world, const glm::dvec3& normal) const;
   const Map& mapFor(int lightIndex, const glm::dvec3& toLight) const;
 
   const Scene& scene_;
