@@ -299,8 +299,9 @@ std::vector<Row> runGrazing(const std::string& name, bool textured, const CaseCo
                           (maps ? " (" + std::to_string(shadows.edgeAcne + shadows.edgeLeaks) +
                                       " within a map texel of an edge)"
                                 : "");
-          row.pass = row.pass && shadows.leaks == 0 && double(shadows.acne) <= 1e-3 * double(shadows.checked) &&
-                     shadows.shadowed.size() == 2 && shadows.shadowed[1] >= 1000;
+          row.pass = row.pass && shadows.leaks == 0 &&
+                     double(shadows.acne) <= 1e-3 * double(shadows.checked) && shadows.shadowed.size() == 2 &&
+                     shadows.shadowed[1] >= 1000;
           addImage(row, writeValueImage(ctx, name, std::string(hybrid ? "hybrid" : "raster") + "-shadows.png",
                                         rendered.image().width, rendered.image().height, shadows.pixels,
                                         "0 fine, 1 acne, 2 leak, 3 edge",
