@@ -4,13 +4,18 @@
 //
 // - Point lights: a cube map, six 90° perspective faces (±X, ±Y, ±Z).
 // - Spot lights: one perspective map with the cone's full angle (2 × outer).
-// - Directional lights: one orthographic map fitted to the scene's
-//   bounding sphere.
+// - Directional lights: one orthographic map fitted to the scene's bounds
+//   as the light sees them, its x and y extents apart.
 // Bias is applied while rendering the maps, as glPolygonOffset does:
 // constant (in units of the format's resolvable difference) plus slope
-// scaled (× the occluder's max depth slope per texel). Too little bias
-// shows acne, too much peter-panning; one texel per lookup (no filtering),
-// so the maps' aliasing stays visible for comparison with traced shadows.
+// scaled (× the occluder's max depth slope per texel); a lookup compares
+// the texel with the receiver's own plane at the texel's sample
+// (receiver-plane depth, taking min with the point's depth), so the bias
+// covers only the maps' rounding and snap, not the receiver's slope
+// across half a texel (docs/SHADOWS.md "Shadow maps": 0 leaks and 0 acne
+// on the stability study's shadow-map cases). One texel per lookup (no
+// filtering), so the maps' aliasing stays visible for comparison with
+// traced shadows.
 // OPAQUE and MASK surfaces (MASK alpha-tested) write depth. BLEND and
 // refractive surfaces attenuate instead, as SPEC §5 asks (1 − α, and
 // transmission × C): each map keeps, per texel, the transmissive fragments
@@ -23,7 +28,7 @@
 // tile-local buffer streamed into the map), with the same keys as the
 // camera pass's keys-only rasterDepthPass. A lookup costs a few double
 // operations (the reference's, inlined: same bits) and one load from the
-// map, which at 2048² misses the caches for most shaded samples; the
+// map, which at 1024² (4 MB a face) misses the caches for many shaded samples; the
 // transmissive fragments are indexed by tile row, so a texel without any
 // costs one more load and no search.
 #pragma once
