@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <mutex>
 #include <string>
 
 #if defined(__SSE2__)
@@ -340,17 +341,62 @@ bool hasAvx2() {
 
 }  // namespace
 
+namespace {
+
+// Kept buffers: (bytes allocated, pointer). Leaked on purpose, so that maps
+// freed during static destruction still find it.
+struct DepthMapPool {
+  std::mutex mutex;
+  std::vector<std::pair<size_t, void*>> kept;
+};
+DepthMapPool& depthMapPool() {
+  static DepthMapPool* pool = new DepthMapPool;
+  return *pool;
+}
+
+}  // namespace
+
+void DepthMapRelease::operator()(uint32_t* keys) const {
+  if (!keys) return;
+  DepthMapPool& pool = depthMapPool();
+  const std::lock_guard<std::mutex> lock(pool.mutex);
+  pool.kept.emplace_back(bytes, keys);
+}
+
+size_t depthMapPoolBytes() {
+  DepthMapPool& pool = depthMapPool();
+  const std::lock_guard<std::mutex> lock(pool.mutex);
+  size_t total = 0;
+  for (const auto& k : pool.kept) total += k.first;
+  return total;
+}
+
 DepthMap::DepthMap(int w, int h) : width(w), height(h) {
   // Whole 2 MB pages (the huge-page size) and at least cache-line aligned.
   constexpr size_t kPage = size_t(2) << 20;
   const size_t bytes = std::max<size_t>(size_t(w) * size_t(h) * sizeof(uint32_t), 1);
   const size_t align = bytes >= kPage ? kPage : 64;
-  void* p = std::aligned_alloc(align, (bytes + align - 1) / align * align);
+  const size_t allocated = (bytes + align - 1) / align * align;
+  {
+    DepthMapPool& pool = depthMapPool();
+    const std::lock_guard<std::mutex> lock(pool.mutex);
+    for (size_t i = 0; i < pool.kept.size(); ++i)
+      if (pool.kept[i].first == allocated) {
+        keys = std::unique_ptr<uint32_t[], DepthMapRelease>(static_cast<uint32_t*>(pool.kept[i].second),
+                                                            DepthMapRelease{allocated});
+        pool.kept[i] = pool.kept.back();
+        pool.kept.pop_back();
+        return;
+      }
+    for (const auto& k : pool.kept) std::free(k.second);  // another size: give the memory back first
+    pool.kept.clear();
+  }
+  void* p = std::aligned_alloc(align, allocated);
   if (!p) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  if (align == kPage) madvise(p, (bytes + align - 1) / align * align, MADV_HUGEPAGE);  // advice only
+  if (align == kPage) madvise(p, allocated, MADV_HUGEPAGE);  // advice only
 #endif
-  keys.reset(static_cast<uint32_t*>(p));
+  keys = std::unique_ptr<uint32_t[], DepthMapRelease>(static_cast<uint32_t*>(p), DepthMapRelease{allocated});
 }
 
 DepthOnlyTile::DepthOnlyTile(const TileRect& rect) : rect_(rect) {

@@ -31,7 +31,7 @@ struct RasterOptions {
   TransparencyMode transparency = TransparencyMode::Exact;
   int peelLayers = 8;  // Peel: layers kept per sample; those behind are dropped
   ShadowMode shadows = ShadowMode::Map;
-  int shadowMapSize = 2048;         // texels per side (per cube face for point lights)
+  int shadowMapSize = 1024;         // texels per side (per cube face for point lights); docs/SHADOWS.md
   float shadowBiasConstant = 1.0f;  // in depth-format units, as glPolygonOffset's
   float shadowBiasSlope = 1.0f;     // × the occluder's max depth slope per texel
   // Sample: shade every visible sample; Pixel: once per pixel and triangle

@@ -9,6 +9,7 @@
 #include "common/interrupt.h"
 #include "common/math_constants.h"
 #include "common/parallel.h"
+#include "common/sampling.h"
 
 namespace rastray {
 
@@ -41,6 +42,46 @@ Camera perspectiveLightCamera(const glm::dvec3& eye, const glm::dvec3& forward, 
   return c;
 }
 
+// A directional light's orthographic map, fitted to the scene's bounds as
+// the light sees them: the box of the eight corners of `bounds` in the
+// light's frame, x and y apart. A bounding sphere wastes resolution on
+// flat scenes under a low light: a 2e3 × 1e5 plane lit 0.1° above its
+// horizon spans 4 units across the light and 1e5 along it, so a square
+// map over the sphere (texels 49 units wide) puts the whole plane and the
+// 0.5-unit wall on it in one texel row, and the wall's shadow is lost.
+// Fitted per axis, a row is 4/size units. Margins: 1e-3 of each extent
+// (the corners are exact, the map's edge texels still cover them) and a
+// floor of 1e-6 of the radius (a plane seen exactly edge-on).
+Camera directionalLightCamera(const Bounds& bounds, const glm::dvec3& centre, double radius,
+                              const glm::dvec3& direction, int size) {
+  Camera c = lightCamera(centre, direction, size);
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  if (bounds.empty()) {
+    lo = glm::dvec3(-radius);
+    hi = glm::dvec3(radius);
+  } else {
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::dvec3 p((corner & 1) ? bounds.hi.x : bounds.lo.x, (corner & 2) ? bounds.hi.y : bounds.lo.y,
+                         (corner & 4) ? bounds.hi.z : bounds.lo.z);
+      const glm::dvec3 v(c.viewFromWorld * glm::dvec4(p, 1.0));
+      lo = glm::min(lo, v);
+      hi = glm::max(hi, v);
+    }
+  }
+  const double floor = 1e-6 * radius;
+  const glm::dvec3 half = glm::max(0.5 * (hi - lo) * 1.001, glm::dvec3(floor));
+  const glm::dvec3 mid = 0.5 * (lo + hi);
+  // The eye on the box's face towards the light, a margin before it.
+  const glm::dvec3 eye = glm::dvec3(c.worldFromView * glm::dvec4(mid.x, mid.y, hi.z + half.z, 1.0));
+  c = lightCamera(eye, direction, size);
+  c.projection = Projection::Orthographic;
+  c.xmag = half.x;
+  c.ymag = half.y;
+  c.znear = 0.0;
+  c.zfar = 4.0 * half.z;
+  return c;
+}
+
 // The cube faces' axes, in face order.
 const glm::dvec3 kCubeAxes[kCubeFaces] = {glm::dvec3(1, 0, 0),  glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0),
                                           glm::dvec3(0, -1, 0), glm::dvec3(0, 0, 1),  glm::dvec3(0, 0, -1)};
@@ -55,6 +96,7 @@ ShadowMaps::Lookup lookupOf(const Camera& camera, const ClipSpace& space) {
   k.perspective = camera.projection == Projection::Perspective;
   k.znear = camera.znear;
   k.zfar = camera.zfar;
+  k.sample = samplePositions(1)[0];
   return k;
 }
 
@@ -79,6 +121,41 @@ void indexAttenuation(const std::vector<std::vector<ShadowMaps::Attenuation>>& p
     for (; next < size_t(kTileSize); ++next) rows[next] = uint32_t(map->attenuation.size());
   }
   map->attenuationRows.back() = uint32_t(map->attenuation.size());
+}
+
+// The receiver's normal in the map's view frame (the rotation of
+// viewFromWorld), one order of operations for both lookups.
+glm::dvec3 viewNormal(const ShadowMaps::Lookup& k, const glm::dvec3& normal) {
+  return (k.column[0] * normal.x + k.column[1] * normal.y) + k.column[2] * normal.z;
+}
+
+// Receiver-plane depth: the view depth to compare with texel (x, y)'s key
+// for the receiver point `view` (view depth d, view-space normal n). A
+// texel holds its nearest surface's depth at its sample (its centre), not
+// at the point up to half a texel away. d_c, the depth of the receiver's
+// plane along the sample's ray, takes the receiver's own slope out of the
+// comparison exactly, for any slope: a lit plane meets its own stored
+// depth up to rounding, which the maps' constant and small slope bias
+// cover (docs/SHADOWS.md "Shadow maps"). The result is min(d, d_c): where
+// the plane runs away from the light towards the sample, a surface there
+// nearer than d_c but farther than the point (a wall rising from a floor
+// lit at a grazing angle: a concave corner) must not shadow the point, and
+// the point's own surface, stored at d_c, still passes. Falls back to d
+// where the plane gives no depth in front of the map (n zero, the texel's
+// ray parallel to the plane, or the plane behind the near plane).
+double receiverDepth(const ShadowMaps::Lookup& k, const glm::dvec3& view, double d, const glm::dvec3& n,
+                     int x, int y) {
+  if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) return d;
+  // The sample's view x and y over depth (its NDC × scale).
+  const double a = (2.0 * (double(x) + k.sample.x) / k.width - 1.0) * k.scale.x;
+  const double b = (1.0 - 2.0 * (double(y) + k.sample.y) / k.height) * k.scale.y;
+  double dc;
+  if (!k.perspective)
+    dc = d + (n.x * (a - view.x) + n.y * (b - view.y)) / n.z;  // the ray (a, b, −t)
+  else
+    dc = (n.x * view.x + n.y * view.y + n.z * view.z) / (n.x * a + n.y * b - n.z);  // the ray t·(a, b, −1)
+  if (!(dc > k.znear) || !std::isfinite(dc)) return d;
+  return std::min(d, dc);
 }
 
 }  // namespace
@@ -132,6 +209,38 @@ std::vector<uint8_t> cubeFaceCandidates(const Scene& scene, const glm::dvec3& ey
   return mask;
 }
 
+ShadowTexel shadowMapTexel(const Scene& scene, int lightIndex, int size, const glm::dvec3& point) {
+  const Light& light = scene.lights.at(size_t(lightIndex));
+  Camera c;
+  double width = 0.0, height = 0.0;
+  if (light.type == LightType::Directional) {
+    glm::dvec3 centre(0.0);
+    double radius = 1.0;
+    if (!scene.bounds.empty()) {
+      centre = 0.5 * (scene.bounds.lo + scene.bounds.hi);
+      radius = std::max(1e-6, 0.5 * glm::length(scene.bounds.hi - scene.bounds.lo));
+    }
+    c = directionalLightCamera(scene.bounds, centre, radius, light.direction, size);
+    width = 2.0 * c.xmag / double(size);
+    height = 2.0 * c.ymag / double(size);
+  } else {
+    // A perspective map: 2·tan(fov/2)/size per unit of depth along its
+    // axis, at the point's depth.
+    glm::dvec3 axis = light.direction;
+    double fov = std::min(2.0 * double(light.outerConeAngle) + 0.01, kPi * 0.95);
+    if (light.type == LightType::Point) {
+      const glm::dvec3 d = point - light.position, a = glm::abs(d);
+      const int k = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
+      axis = kCubeAxes[2 * k + (d[k] > 0 ? 0 : 1)];
+      fov = kPi / 2.0 + 2.0 / size;
+    }
+    c = lightCamera(light.position, axis, size);
+    width = height =
+        std::abs(glm::dot(point - light.position, axis)) * 2.0 * std::tan(0.5 * fov) / double(size);
+  }
+  return {glm::dvec3(c.worldFromView[0]) * width, glm::dvec3(c.worldFromView[1]) * height};
+}
+
 ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const Shader* shader,
                        CoveragePath path)
     : scene_(scene) {
@@ -147,12 +256,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
     const Light& light = scene.lights[l];
     std::vector<Camera> cameras;
     if (light.type == LightType::Directional) {
-      Camera c = lightCamera(centre - light.direction * (2.0 * radius), light.direction, size);
-      c.projection = Projection::Orthographic;
-      c.xmag = c.ymag = radius * 1.001;
-      c.znear = 0.0;
-      c.zfar = 4.0 * radius;
-      cameras.push_back(c);
+      cameras.push_back(directionalLightCamera(scene.bounds, centre, radius, light.direction, size));
     } else {
       // Near plane: small against the scene, far: infinite.
       const double znear = std::max(1e-6, 1e-4 * radius);
@@ -250,7 +354,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
 
 // The reference lookup: project with the general functions, then binary
 // search the tile's fragments for the texel.
-glm::vec3 ShadowMaps::litReference(const Map& map, const glm::dvec3& world) const {
+glm::vec3 ShadowMaps::litReference(const Map& map, const glm::dvec3& world, const glm::dvec3& normal) const {
   const glm::dvec3 view(map.camera.viewFromWorld * glm::dvec4(world, 1.0));
   const ClipVertex v = map.space.project(view, glm::dvec3(0.0));
   const glm::vec3 one(1.0f);
@@ -258,8 +362,8 @@ glm::vec3 ShadowMaps::litReference(const Map& map, const glm::dvec3& world) cons
   const glm::dvec2 image = map.space.imageOf(v.position);
   const int x = int(std::floor(image.x)), y = int(std::floor(image.y));
   if (x < 0 || y < 0 || x >= map.depth.width || y >= map.depth.height) return one;
-  const double z =
-      windowDepth(kMapFormat, map.camera.projection, map.camera.znear, map.camera.zfar, v.position.z);
+  const double d = receiverDepth(map.lookup, view, v.position.z, viewNormal(map.lookup, normal), x, y);
+  const double z = windowDepth(kMapFormat, map.camera.projection, map.camera.znear, map.camera.zfar, d);
   const uint32_t key = depthKey(kMapFormat, z);
   const uint32_t texel = uint32_t(map.depth.index(x, y));
   if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
@@ -279,7 +383,7 @@ glm::vec3 ShadowMaps::litReference(const Map& map, const glm::dvec3& world) cons
 // ClipSpace::project and imageOf, and the reversed window depth formula of
 // common/depth_formula.cpp; only the calls, the unused fourth row and the
 // search over the whole tile are gone.
-glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world) const {
+glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world, const glm::dvec3& normal) const {
   static_assert(kMapFormat == DepthFormat::FloatReversed, "lit() inlines the reversed window depth");
   const Lookup& k = map.lookup;
   const glm::dvec3 view =
@@ -292,13 +396,14 @@ glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world) const {
   const double iy = (1.0 - view.y / k.scale.y / w) * 0.5 * k.height;
   const int x = int(std::floor(ix)), y = int(std::floor(iy));
   if (x < 0 || y < 0 || x >= map.depth.width || y >= map.depth.height) return one;
+  const double dc = receiverDepth(k, view, d, viewNormal(k, normal), x, y);
   double z;  // reversedWindowDepth
   if (!k.perspective)
-    z = (k.zfar - d) / (k.zfar - k.znear);
+    z = (k.zfar - dc) / (k.zfar - k.znear);
   else if (std::isinf(k.zfar))
-    z = k.znear / d;
+    z = k.znear / dc;
   else
-    z = k.znear * (k.zfar - d) / (d * (k.zfar - k.znear));
+    z = k.znear * (k.zfar - dc) / (dc * (k.zfar - k.znear));
   const uint32_t key = depthKey(kMapFormat, z);
   const uint32_t texel = uint32_t(map.depth.index(x, y));
   if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
@@ -334,30 +439,31 @@ const ShadowMaps::Map& ShadowMaps::mapFor(int lightIndex, const glm::dvec3& toLi
   return maps[size_t(face)];
 }
 
-glm::vec3 ShadowMaps::lightTransmittance(int lightIndex, const glm::dvec3& world,
+glm::vec3 ShadowMaps::lightTransmittance(int lightIndex, const glm::dvec3& world, const glm::dvec3& normal,
                                          const glm::dvec3& toLight) const {
   if (perLight_[size_t(lightIndex)].empty()) return glm::vec3(1.0f);
-  return lit(mapFor(lightIndex, toLight), world);
+  return lit(mapFor(lightIndex, toLight), world, normal);
 }
 
 void ShadowMaps::lightTransmittances(int lightIndex, size_t n, const glm::dvec3* world,
-                                     const glm::dvec3* toLight, glm::vec3* out) const {
+                                     const glm::dvec3* normal, const glm::dvec3* toLight,
+                                     glm::vec3* out) const {
   if (perLight_[size_t(lightIndex)].empty()) {
     std::fill_n(out, n, glm::vec3(1.0f));
     return;
   }
-  for (size_t i = 0; i < n; ++i) out[i] = lit(mapFor(lightIndex, toLight[i]), world[i]);
+  for (size_t i = 0; i < n; ++i) out[i] = lit(mapFor(lightIndex, toLight[i]), world[i], normal[i]);
 }
 
 glm::vec3 ShadowMaps::lightTransmittanceReference(int lightIndex, const glm::dvec3& world,
-                                                  const glm::dvec3& toLight) const {
+                                                  const glm::dvec3& normal, const glm::dvec3& toLight) const {
   if (perLight_[size_t(lightIndex)].empty()) return glm::vec3(1.0f);
-  return litReference(mapFor(lightIndex, toLight), world);
+  return litReference(mapFor(lightIndex, toLight), world, normal);
 }
 
 glm::vec3 ShadowMaps::transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
                                     double) const {
-  return lightTransmittance(lightIndex, point.position, toLight);
+  return lightTransmittance(lightIndex, point.position, point.geometricNormal, toLight);
 }
 
 }  // namespace rastray

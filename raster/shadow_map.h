@@ -4,13 +4,18 @@
 //
 // - Point lights: a cube map, six 90° perspective faces (±X, ±Y, ±Z).
 // - Spot lights: one perspective map with the cone's full angle (2 × outer).
-// - Directional lights: one orthographic map fitted to the scene's
-//   bounding sphere.
+// - Directional lights: one orthographic map fitted to the scene's bounds
+//   as the light sees them, its x and y extents apart.
 // Bias is applied while rendering the maps, as glPolygonOffset does:
 // constant (in units of the format's resolvable difference) plus slope
-// scaled (× the occluder's max depth slope per texel). Too little bias
-// shows acne, too much peter-panning; one texel per lookup (no filtering),
-// so the maps' aliasing stays visible for comparison with traced shadows.
+// scaled (× the occluder's max depth slope per texel); a lookup compares
+// the texel with the receiver's own plane at the texel's sample
+// (receiver-plane depth, taking min with the point's depth), so the bias
+// covers only the maps' rounding and snap, not the receiver's slope
+// across half a texel (docs/SHADOWS.md "Shadow maps": 0 leaks and 0 acne
+// on the stability study's shadow-map cases). One texel per lookup (no
+// filtering), so the maps' aliasing stays visible for comparison with
+// traced shadows.
 // OPAQUE and MASK surfaces (MASK alpha-tested) write depth. BLEND and
 // refractive surfaces attenuate instead, as SPEC §5 asks (1 − α, and
 // transmission × C): each map keeps, per texel, the transmissive fragments
@@ -23,7 +28,7 @@
 // tile-local buffer streamed into the map), with the same keys as the
 // camera pass's keys-only rasterDepthPass. A lookup costs a few double
 // operations (the reference's, inlined: same bits) and one load from the
-// map, which at 2048² misses the caches for most shaded samples; the
+// map, which at 1024² (4 MB a face) misses the caches for many shaded samples; the
 // transmissive fragments are indexed by tile row, so a texel without any
 // costs one more load and no search.
 #pragma once
@@ -53,6 +58,17 @@ std::vector<Camera> cubeFaceCameras(const glm::dvec3& eye, int size, double znea
 // candidates and the maps stay identical.
 std::vector<uint8_t> cubeFaceCandidates(const Scene& scene, const glm::dvec3& eye, double t, int size);
 
+// One texel of light `lightIndex`'s map (maps of `size` texels a side, as
+// ShadowMaps renders them) near `point`: its two sides as world vectors
+// across the light (a directional map's are uniform; a cube face's or
+// spot map's at the point's depth along the face's axis). A one-texel
+// lookup cannot place a shadow edge closer than this; the stability study
+// uses it to tell the maps' resolution from their bias.
+struct ShadowTexel {
+  glm::dvec3 side[2];
+};
+ShadowTexel shadowMapTexel(const Scene& scene, int lightIndex, int size, const glm::dvec3& point);
+
 class ShadowMaps : public LightVisibility {
  public:
   // Renders the maps of every light (none without lights). `shader`
@@ -65,18 +81,21 @@ class ShadowMaps : public LightVisibility {
   glm::vec3 transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
                           double distance) const override;
 
-  // The transmittance of light `lightIndex` at `world`, `toLight` the
-  // direction from the point towards the light (it picks the cube face):
-  // what transmittance() returns for a point at `world`. Plain members,
-  // not virtual, for callers that shade many points at once: the batch
-  // form looks up n points of one light.
-  glm::vec3 lightTransmittance(int lightIndex, const glm::dvec3& world, const glm::dvec3& toLight) const;
-  void lightTransmittances(int lightIndex, size_t n, const glm::dvec3* world, const glm::dvec3* toLight,
-                           glm::vec3* out) const;
+  // The transmittance of light `lightIndex` at `world` on a surface of
+  // unit geometric normal `normal` (either side; zero: compare the point's
+  // own depth, no receiver plane), `toLight` the direction from the point
+  // towards the light (it picks the cube face): what transmittance()
+  // returns for that surface point. Plain members, not virtual, for
+  // callers that shade many points at once: the batch form looks up n
+  // points of one light.
+  glm::vec3 lightTransmittance(int lightIndex, const glm::dvec3& world, const glm::dvec3& normal,
+                               const glm::dvec3& toLight) const;
+  void lightTransmittances(int lightIndex, size_t n, const glm::dvec3* world, const glm::dvec3* normal,
+                           const glm::dvec3* toLight, glm::vec3* out) const;
   // The same from the scalar reference lookup: the general matrix and
   // window-depth functions, and a binary search of the map tile's
   // attenuating fragments. The tests demand the same bits.
-  glm::vec3 lightTransmittanceReference(int lightIndex, const glm::dvec3& world,
+  glm::vec3 lightTransmittanceReference(int lightIndex, const glm::dvec3& world, const glm::dvec3& normal,
                                         const glm::dvec3& toLight) const;
 
   uint64_t trianglesRendered() const { return triangles_; }
@@ -99,6 +118,7 @@ class ShadowMaps : public LightVisibility {
     double width = 0.0, height = 0.0;
     bool perspective = true;
     double znear = 0.0, zfar = 0.0;
+    glm::dvec2 sample{0.5};  // a texel's sample position within it
   };
   struct Map {
     Camera camera;
@@ -119,8 +139,8 @@ class ShadowMaps : public LightVisibility {
   const Map& mapAt(size_t i) const;
 
  private:
-  glm::vec3 lit(const Map& map, const glm::dvec3& world) const;
-  glm::vec3 litReference(const Map& map, const glm::dvec3& world) const;
+  glm::vec3 lit(const Map& map, const glm::dvec3& world, const glm::dvec3& normal) const;
+  glm::vec3 litReference(const Map& map, const glm::dvec3& world, const glm::dvec3& normal) const;
   const Map& mapFor(int lightIndex, const glm::dvec3& toLight) const;
 
   const Scene& scene_;

@@ -236,6 +236,8 @@ constexpr int kGrazingW = 160, kGrazingH = 120;
 // and on to the sky, so the picture shows the checker fading into its
 // coarsest mip level and the wall receding.
 constexpr double kGrazingYfov = 10.0;
+// checkShadows' edge tolerance: the far case's 1e-3 world units.
+constexpr double kGrazingShadowTolerance = 1e-3;
 
 std::vector<Row> runGrazing(const std::string& name, bool textured, const CaseContext& ctx,
                             const std::string& path) {
@@ -278,6 +280,32 @@ std::vector<Row> runGrazing(const std::string& name, bool textured, const CaseCo
           row.metric = r.hybridWhereAgree.maxError;
           row.property += ", colour = ray caster's within 1e-5 where hits agree";
           row.pass = row.pass && r.hybridWhereAgree.maxError <= 1e-5;
+        }
+        if (!textured && format.empty() && view.label.empty()) {
+          // Acne and leaks of both lights against the double reference.
+          // Every normal here is exact (an axis-aligned plane and wall),
+          // so samples under the 89.9° light (n·l = 0.0017) count too; the
+          // shadow it casts, 286 units wide, must stay: each of its
+          // samples the map lit would be a leak.
+          Rendered rendered{renderSettingsFrom(args, true), Scene{}, hybrid ? r.hybrid : r.raster};
+          rendered.scene = loadSceneForRender(path, rendered.settings);
+          const ShadowCheck shadows =
+              checkShadows(rendered, kGrazingShadowTolerance, 1e-3, shadowMapTexels(rendered));
+          row.acne = shadows.acne;
+          row.leaks = shadows.leaks;
+          const bool maps = bool(shadowMapTexels(rendered));
+          row.property += std::string(", 0 leaks, acne <= 0.1 % of ") + std::to_string(shadows.checked) +
+                          " samples checked, >= 1000 of them in the grazing light's shadow" +
+                          (maps ? " (" + std::to_string(shadows.edgeAcne + shadows.edgeLeaks) +
+                                      " within a map texel of an edge)"
+                                : "");
+          row.pass = row.pass && shadows.leaks == 0 &&
+                     double(shadows.acne) <= 1e-3 * double(shadows.checked) && shadows.shadowed.size() == 2 &&
+                     shadows.shadowed[1] >= 1000;
+          addImage(row, writeValueImage(ctx, name, std::string(hybrid ? "hybrid" : "raster") + "-shadows.png",
+                                        rendered.image().width, rendered.image().height, shadows.pixels,
+                                        "0 fine, 1 acne, 2 leak, 3 edge",
+                                        "against the double-precision shadow reference (dark: not checked)"));
         }
         if (textured && !hybrid) {
           const RenderSettings settings = renderSettingsFrom(args, true);
@@ -362,10 +390,22 @@ std::vector<Row> runScale(const std::string& name, double scale, const CaseConte
       row.seconds = a.seconds();
       row.metricName = "pixels off by > 0.1 (fraction)";
       row.metric = fractionOff(a.image(), ref.image(), 0.1);
+      // Acne and leaks against the double reference, its edge tolerance
+      // scaled with the scene (1e-3 of the unit scene's ~8 units).
+      const TexelWidth texels = shadowMapTexels(a);
+      const ShadowCheck shadows = checkShadows(a, 1e-3 * scale, 0.1, texels);
+      row.acne = shadows.acne;
+      row.leaks = shadows.leaks;
       if (v.asserts) {
         row.property = "renders like the unit scene: < " + fmt("%g", kScaleBound) +
                        " of pixels off by > 0.1, 0 genuine mismatches, no NaN/Inf";
         row.pass = row.metric < kScaleBound && row.genuine == 0 && row.nanInf == 0;
+        if (texels) {  // shadow maps (issue 24): the default biases at every scale
+          row.property += ", 0 leaks, acne <= 0.1 % of " + std::to_string(shadows.checked) + " samples (" +
+                          std::to_string(shadows.edgeAcne + shadows.edgeLeaks) +
+                          " within a map texel of an edge)";
+          row.pass = row.pass && shadows.leaks == 0 && double(shadows.acne) <= 1e-3 * double(shadows.checked);
+        }
       }
       const std::string tag = v.label == "raster" || v.label == "raytrace" || !v.asserts ? v.label : "";
       if (!tag.empty()) {

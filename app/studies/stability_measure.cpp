@@ -1,6 +1,7 @@
 #include "app/studies/stability_measure.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "common/sampling.h"
 #include "compare/classify.h"
 #include "compare/maps.h"
+#include "raster/shadow_map.h"
 
 namespace rastray::stability {
 
@@ -111,14 +113,17 @@ double insideDistance(const DoubleTriangle& t, const glm::dvec3& q) {
 
 }  // namespace
 
-ShadowCheck checkShadows(const Rendered& r, double tolerance) {
+ShadowCheck checkShadows(const Rendered& r, double tolerance, double minCosine,
+                         const TexelWidth& texelWidth) {
   ShadowCheck out;
   const Scene& scene = r.scene;
-  if (scene.lights.size() != 1) return out;
-  const Light& light = scene.lights[0];
-  if (light.type == LightType::Spot || (light.type == LightType::Point && light.range > 0.0f)) return out;
+  if (scene.lights.empty()) return out;
+  for (const Light& light : scene.lights)
+    if (light.type == LightType::Spot || (light.type == LightType::Point && light.range > 0.0f)) return out;
   if (!r.run.output.hasSamples) throw std::logic_error("checkShadows: the render needs its samples");
   out.acne = out.leaks = 0;
+  out.shadowed.assign(scene.lights.size(), 0);
+  std::vector<uint8_t> darkLights(scene.lights.size());
 
   std::vector<DoubleTriangle> triangles(scene.triangles.size());
   for (const Instance& inst : scene.instances)
@@ -133,6 +138,58 @@ ShadowCheck checkShadows(const Rendered& r, double tolerance) {
       t.opaque = m.alphaMode == AlphaMode::Opaque && m.transmission == 0.0f;
     }
 
+  // Whether an opaque triangle other than `own` blocks the segment from q
+  // towards the light (farther than `distance`: none); `nearEdge` is set
+  // when the segment passes within `tolerance` of an edge it does not
+  // clearly cross.
+  uint32_t own = 0;
+  const auto blocked = [&](const glm::dvec3& q, const glm::dvec3& toLight, double distance, bool* nearEdge) {
+    for (size_t j = 0; j < triangles.size(); ++j) {
+      if (j == own) continue;
+      const DoubleTriangle& o = triangles[j];
+      const double d = glm::dot(o.n, toLight);
+      if (d == 0.0) continue;  // parallel (or degenerate)
+      const double t = glm::dot(o.a - q, o.n) / d;
+      if (!(t > 1e-6 && t < distance)) continue;
+      const double inside = insideDistance(o, q + toLight * t);
+      if (inside > tolerance && o.opaque) return true;
+      if (inside > -tolerance) *nearEdge = true;
+    }
+    return false;
+  };
+  // Whether the reference visibility of some light changes within one map
+  // texel of p: p moved in its plane (normal n) along the light so that
+  // its place in the map moves by one texel side, both ways, each side.
+  const auto nearShadowEdge = [&](const glm::dvec3& p, const glm::dvec3& n) {
+    for (size_t l = 0; l < scene.lights.size(); ++l) {
+      const Light& light = scene.lights[l];
+      const auto towards = [&](const glm::dvec3& q, double* distance) {
+        *distance = INFINITY;
+        if (light.type != LightType::Point) return glm::dvec3(-light.direction);
+        const glm::dvec3 v = light.position - q;
+        *distance = glm::length(v);
+        return v / *distance;
+      };
+      double distance;
+      const glm::dvec3 toLight = towards(p, &distance);
+      const double cosine = glm::dot(n, toLight);
+      if (cosine <= 0.0) continue;
+      bool ignored = false;
+      const bool here = blocked(p, toLight, distance, &ignored);
+      const std::array<glm::dvec3, 2> sides = texelWidth(int(l), p);
+      for (const glm::dvec3& side : sides)
+        for (const double sign : {1.0, -1.0}) {
+          const glm::dvec3 e = sign * side;
+          // Back to the plane along the light: the same place in the map.
+          const glm::dvec3 q = p + e - toLight * (glm::dot(n, e) / cosine);
+          double d;
+          const glm::dvec3 to = towards(q, &d);
+          if (blocked(q, to, d, &ignored) != here) return true;
+        }
+    }
+    return false;
+  };
+
   const Camera& camera = r.camera();
   const DeepImage& deep = r.run.output.samples;
   const std::vector<glm::dvec2> offsets = samplePositions(r.settings.spp);
@@ -146,7 +203,7 @@ ShadowCheck checkShadows(const Rendered& r, double tolerance) {
         if (s.sample == lastSample) continue;  // only the front layer
         lastSample = s.sample;
         if (s.instance == kNoId || s.sample >= offsets.size() || !diffuseOnly(scene, s.instance)) continue;
-        const uint32_t own = scene.instanceOf(s.instance).firstTriangle + s.triangle;
+        own = scene.instanceOf(s.instance).firstTriangle + s.triangle;
         const DoubleTriangle& tri = triangles[own];
         const Ray ray = camera.primaryRay(glm::dvec2(x, y) + offsets[s.sample]);
         const double denom = glm::dot(ray.direction, tri.n);
@@ -154,56 +211,87 @@ ShadowCheck checkShadows(const Rendered& r, double tolerance) {
         const glm::dvec3 p = ray.origin + ray.direction * (glm::dot(tri.a - ray.origin, tri.n) / denom);
         glm::dvec3 n = glm::normalize(tri.n);
         if (glm::dot(n, ray.direction) > 0.0) n = -n;  // the side the camera sees
-
-        glm::dvec3 toLight = -light.direction;
-        double distance = INFINITY, irradiance = light.intensity;
-        if (light.type == LightType::Point) {
-          toLight = light.position - p;
-          distance = glm::length(toLight);
-          toLight /= distance;
-          irradiance = light.intensity / (distance * distance);
-        }
-        const double cosine = glm::dot(n, toLight);
         const glm::vec4& albedo = scene.materialOf(s.instance).baseColorFactor;
-        const double expected = irradiance * std::max(cosine, 0.0) / kPi *
-                                (double(albedo.r) * light.color.r + double(albedo.g) * light.color.g +
-                                 double(albedo.b) * light.color.b);
-        if (cosine < 0.1 || expected < 1e-3) {
+
+        // Each light's unshadowed share of the RGB sum and its reference
+        // visibility; the sample is skipped when any light with a share is
+        // undecided.
+        double reference = 0.0;          // the RGB sum the reference predicts
+        double smallestLit = INFINITY;   // the smallest share of a light it says reaches
+        double smallestDark = INFINITY;  // ... of a light it says is blocked
+        bool ambiguous = false;
+        std::fill(darkLights.begin(), darkLights.end(), 0);
+        for (size_t l = 0; l < scene.lights.size(); ++l) {
+          const Light& light = scene.lights[l];
+          glm::dvec3 toLight = -light.direction;
+          double distance = INFINITY, irradiance = light.intensity;
+          if (light.type == LightType::Point) {
+            toLight = light.position - p;
+            distance = glm::length(toLight);
+            toLight /= distance;
+            irradiance = light.intensity / (distance * distance);
+          }
+          const double cosine = glm::dot(n, toLight);
+          if (cosine <= 0.0) continue;  // faces away: no share under any visibility
+          const double share = irradiance * cosine / kPi *
+                               (double(albedo.r) * light.color.r + double(albedo.g) * light.color.g +
+                                double(albedo.b) * light.color.b);
+          if (cosine < minCosine || share < 1e-3) {
+            ambiguous = true;
+            break;
+          }
+          bool nearEdge = false;
+          const bool occluded = blocked(p, toLight, distance, &nearEdge);
+          if (!occluded && nearEdge) {
+            ambiguous = true;
+            break;
+          }
+          if (occluded) {
+            darkLights[l] = 1;
+            smallestDark = std::min(smallestDark, share);
+          } else {
+            reference += share;
+            smallestLit = std::min(smallestLit, share);
+          }
+        }
+        if (ambiguous) {
           ++out.ambiguous;
           continue;
         }
-        bool occluded = false, nearEdge = false;
-        for (size_t j = 0; j < triangles.size() && !occluded; ++j) {
-          if (j == own) continue;
-          const DoubleTriangle& o = triangles[j];
-          const double d = glm::dot(o.n, toLight);
-          if (d == 0.0) continue;  // parallel (or degenerate)
-          const double t = glm::dot(o.a - p, o.n) / d;
-          if (!(t > 1e-6 && t < distance)) continue;
-          const double inside = insideDistance(o, p + toLight * t);
-          if (inside > tolerance && o.opaque)
-            occluded = true;
-          else if (inside > -tolerance)
-            nearEdge = true;
-        }
-        if (!occluded && nearEdge) {
-          ++out.ambiguous;
-          continue;
-        }
-        const bool lit = double(s.color.r) + double(s.color.g) + double(s.color.b) > 0.5 * expected;
+        if (smallestLit == INFINITY && smallestDark == INFINITY) continue;  // no light reaches this side
+        const double sum = double(s.color.r) + double(s.color.g) + double(s.color.b);
         ++out.checked;
+        for (size_t l = 0; l < darkLights.size(); ++l) out.shadowed[l] += darkLights[l];
         float& mark = out.pixels[pixel];
         if (std::isnan(mark)) mark = 0.0f;
-        if (!occluded && !lit) {
+        const bool acne = sum<reference - 0.5 * smallestLit, leak = sum> reference + 0.5 * smallestDark;
+        if ((acne || leak) && texelWidth && nearShadowEdge(p, n)) {
+          // The map's resolution, not its bias: counted apart.
+          ++(acne ? out.edgeAcne : out.edgeLeaks);
+          mark = std::max(mark, 3.0f);
+        } else if (acne) {
           ++out.acne;
           mark = std::max(mark, 1.0f);
-        } else if (occluded && lit) {
+        } else if (leak) {
           ++out.leaks;
           mark = 2.0f;
         }
       }
     }
   return out;
+}
+
+TexelWidth shadowMapTexels(const Rendered& r) {
+  const std::vector<std::string>& passes = r.run.output.passesRun;
+  const bool maps = std::any_of(passes.begin(), passes.end(),
+                                [](const std::string& p) { return p.rfind("shadow maps:", 0) == 0; });
+  if (!maps) return {};
+  const Scene* scene = &r.scene;
+  const int size = r.settings.raster.shadowMapSize;
+  return [scene, size](int light, const glm::dvec3& p) {
+    const ShadowTexel t = shadowMapTexel(*scene, light, size, p);
+    return std::array<glm::dvec3, 2>{t.side[0], t.side[1]};
+  };
 }
 
 std::vector<float> pixelDifference(const FlatImage& a, const FlatImage& b) {

@@ -6,7 +6,9 @@
 // these numbers, assert this property".
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -70,32 +72,55 @@ CrossvalResult crossvalidateVariant(const CaseContext& ctx, const std::string& s
 //
 // For every sample's front layer on a diffuse surface (no mirror weight, no
 // transmission, no texture, no emission, opaque: where the shading is
-// exactly C/π · E · V · max(0, n·l), common/shading.h) the exact hit point
-// is rebuilt in double in the file's world frame (Scene::worldPositions):
-// the sample's camera ray, moved from the render's rebased frame by
-// Camera::worldOrigin, met with the plane of the triangle the render names.
-// A brute-force double shadow ray from there to the light is tested against
-// every other triangle of the scene (cases are small). Whether the renderer
-// lit the sample is read from its colour: lit when its RGB sum exceeds half
-// of the unshadowed C/π · E · (n·l) (n: the exact face normal, turned to
-// the viewer), so one render suffices and any renderer (shadow rays or
-// shadow maps) can be checked.
-//   acne: the reference says lit, the renderer darkened the sample;
-//   leak: the reference says shadowed, the renderer lit it.
-// Samples the reference cannot decide are skipped: n·l < 0.1 (the
-// terminator, where a renderer's float normal may legitimately flip), or a
-// shadow ray passing within `tolerance` (world units) of an occluder's
-// edge, or a triangle within 1e-6 along the ray (a coplanar neighbour).
-// Needs exactly one directional or point light (without range); otherwise
-// acne and leaks are -1 (not measured).
+// exactly Σ_l C/π · E_l · V_l · max(0, n·l), common/shading.h) the exact
+// hit point is rebuilt in double in the file's world frame
+// (Scene::worldPositions): the sample's camera ray, moved from the render's
+// rebased frame by Camera::worldOrigin, met with the plane of the triangle
+// the render names. A brute-force double shadow ray from there to each
+// light is tested against every other triangle of the scene (cases are
+// small). Whether the renderer lit the sample is read from its colour
+// (the RGB sum), so one render suffices and any renderer (shadow rays or
+// shadow maps) can be checked: with R the sum the reference predicts (the
+// shares C/π · E_l · (n·l) of the lights it says reach, n the exact face
+// normal turned to the viewer),
+//   acne: the sum is below R by more than half the smallest share of a
+//         light the reference says reaches the point (the renderer
+//         darkened it);
+//   leak: the sum is above R by more than half the smallest share of a
+//         light the reference says is blocked (the renderer lit it).
+// With one light this is "lit when the sum exceeds half the unshadowed
+// sum". Samples the reference cannot decide are skipped: a light with
+// 0 < n·l < `minCosine` (the terminator, where a renderer's float normal
+// may legitimately flip; 0.1 by default, lower only where the normals are
+// exact, e.g. an axis-aligned plane under a grazing light), or a shadow
+// ray passing within `tolerance` (world units) of an occluder's edge, or
+// a triangle within 1e-6 along the ray (a coplanar neighbour).
+// Needs directional or point lights (without range); otherwise (spot
+// lights, ranged lights, no light) acne and leaks are -1 (not measured).
+// With `texelWidth` (a shadow-map render: the two sides of light l's map
+// texel near a point as world vectors, raster/shadow_map.h
+// shadowMapTexel), a disagreeing sample whose reference visibility changes
+// when the point moves in its plane to the next texel (either side, both
+// ways) is a shadow edge the map cannot place closer: it counts in
+// edgeAcne / edgeLeaks instead (one-texel lookups, no filtering), so acne
+// and leaks measure the bias alone. Ray renderers pass none.
+using TexelWidth = std::function<std::array<glm::dvec3, 2>(int light, const glm::dvec3& point)>;
 struct ShadowCheck {
   int64_t acne = -1, leaks = -1;
-  uint64_t checked = 0;    // samples decided and compared
-  uint64_t ambiguous = 0;  // skipped by the rules above
-  // Per pixel: 0 fine, 1 acne in some sample, 2 a leak, NaN not checked.
+  int64_t edgeAcne = 0, edgeLeaks = 0;  // within one map texel of a shadow edge (with texelWidth)
+  uint64_t checked = 0;                 // samples decided and compared
+  std::vector<uint64_t> shadowed;       // of them, by light: blocked from it by the reference
+  uint64_t ambiguous = 0;               // skipped by the rules above
+  // Per pixel: 0 fine, 1 acne in some sample, 2 a leak, 3 an edge
+  // disagreement (with texelWidth), NaN not checked.
   std::vector<float> pixels;
 };
-ShadowCheck checkShadows(const Rendered& r, double tolerance);
+ShadowCheck checkShadows(const Rendered& r, double tolerance, double minCosine = 0.1,
+                         const TexelWidth& texelWidth = {});
+
+// The texelWidth for checkShadows of a render that drew shadow maps (its
+// passes say so), else empty.
+TexelWidth shadowMapTexels(const Rendered& r);
 
 // Colour difference of two same-size flat images: the largest |A − B| over
 // the RGBA channels of each pixel (linear, premultiplied, as rendered).

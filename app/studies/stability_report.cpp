@@ -191,12 +191,12 @@ void writeStabilityReport(const std::string& dir, const std::vector<CaseResult>&
     }
   }
   b += "</table>";
-  b +=
-      "<p>agree %: the share of compared samples and layers whose (instance, triangle) match the reference; "
-      "genuine: mismatching layers no tolerance explains (compare/classify.h). Acne: lit samples darkened by "
-      "their own surface; leaks: samples lit where a double-precision shadow ray says shadowed. Mismatch "
-      "maps use this legend:</p>" +
-      mismatchLegendHtml();
+  b += "<p>agree %: the share of compared samples and layers whose (instance, triangle) match the reference; "
+       "genuine: mismatching layers no tolerance explains (compare/classify.h). Acne: samples darkened where "
+       "double-precision shadow rays say a light reaches them; leaks: samples lit where they say it is "
+       "blocked. For shadow maps, disagreements within one map texel of a shadow edge (the maps' resolution, "
+       "not their bias) are counted apart, in the property text. Mismatch maps use this legend:</p>" +
+       mismatchLegendHtml();
 
   for (const CaseResult& c : results) {
     b += "<section id=\"" + escapeHtml(c.name) + "\"><h2>" + escapeHtml(c.name) + "</h2><p>" +

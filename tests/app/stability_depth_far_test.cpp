@@ -1,7 +1,8 @@
 // The stability study's depth and far-from-origin cases
-// (app/studies/stability_cases_depth.cpp, app/studies/stability_cases_far.cpp) run in
-// process at their --quick sizes: every row must hold its property, and
-// the failure modes the cases exist to show must still show. Plus the
+// (app/studies/stability_cases_depth.cpp, app/studies/stability_cases_far.cpp), and the
+// grazing and scale cases' shadow maps, run in process at their --quick
+// sizes: every row must hold its property, and the failure modes the
+// cases exist to show must still show. Plus the
 // double-precision shadow reference (checkShadows) on a scene whose shadow
 // is known, including a render doctored to leak and to show acne.
 #ifdef RASTRAY_HAVE_RENDERERS
@@ -24,6 +25,7 @@ Case findCase(const std::string& name) {
   std::vector<Case> cases;
   appendDepthCases(cases);
   appendFarCases(cases);
+  appendGeometryCases(cases);
   for (const Case& c : cases)
     if (c.name == name) return c;
   ADD_FAILURE() << "no case " << name;
@@ -113,6 +115,38 @@ TEST(StabilityFar, Node1e6WithMitigationsRendersLikeTheOrigin) {
   EXPECT_EQ(rowOf(rows, "raytrace on").leaks, 0);
   EXPECT_GT(rowOf(rows, "raytrace off").leaks, 100);  // float-ulps offsets jump the 0.01 contact gap
   EXPECT_GT(rowOf(rows, "raytrace off").metric, 1.0);
+}
+
+// Issue 24: the shadow maps' default biases leave no leak and at most
+// 0.1 % acne against the double reference, far from the origin too (edge
+// disagreements within one map texel are counted apart).
+void expectShadowMapBounds(const Row& raster) {
+  EXPECT_EQ(raster.leaks, 0) << raster.caseName;
+  EXPECT_GE(raster.acne, 0) << raster.caseName;  // measured
+  EXPECT_NE(raster.property.find("0 leaks, acne <= 0.1 %"), std::string::npos) << raster.property;
+}
+
+TEST(StabilityShadowMaps, FarCasesKeepTheBiasBounds) {
+  for (const char* name : {"far-node-1e3", "far-node-1e6", "far-baked-1e6"}) {
+    const auto rows = runCase(name);  // asserts every row's property, the bound included
+    expectShadowMapBounds(rowOf(rows, "raster on"));
+  }
+}
+
+// The grazing case (two lights, one 89.9° from the plane's normal) with the
+// rasterizer's shadow maps: its bound, and the grazing light's shadow kept
+// (the case asserts ≥ 1000 checked samples in it, each a leak if lost).
+TEST(StabilityShadowMaps, GrazingLightKeepsItsShadow) {
+  const auto rows = runCase("grazing-lit-89.9");
+  const Row& raster = rowOf(rows, "raster vs raytrace");
+  expectShadowMapBounds(raster);
+  EXPECT_EQ(raster.acne, 0);
+  EXPECT_TRUE(raster.pass) << raster.property;
+  EXPECT_EQ(rowOf(rows, "hybrid vs raytrace").leaks, 0);  // traced shadows: the same reference agrees
+}
+
+TEST(StabilityShadowMaps, ScaledScenesKeepTheBiasBounds) {
+  for (const char* name : {"scale-1e-4", "scale-1e4"}) expectShadowMapBounds(rowOf(runCase(name), "raster"));
 }
 
 TEST(StabilityFar, Node1e7WithMitigationsRendersLikeTheOrigin) {

@@ -319,5 +319,27 @@ TEST(DepthOnlyPass, EmptyTilesAreCleared) {
   EXPECT_EQ(m.keys, std::vector<uint32_t>(size_t(size) * size, kClearDepthKey));
 }
 
+// DepthMap storage is kept for the next map of its size (no fresh pages
+// to zero each frame) and given back when a map of another size comes.
+TEST(DepthMapPool, AFreedMapIsReusedForItsSizeAndGivenBackForAnother) {
+  const uint32_t* first = nullptr;
+  {
+    const DepthMap a(300, 200);
+    first = a.keys.get();
+  }
+  EXPECT_EQ(depthMapPoolBytes(), size_t(300 * 200 * 4));  // 240,000 B: a multiple of 64
+  {
+    const DepthMap b(300, 200);
+    EXPECT_EQ(b.keys.get(), first);
+    EXPECT_EQ(depthMapPoolBytes(), 0u);
+  }
+  EXPECT_EQ(depthMapPoolBytes(), size_t(300 * 200 * 4));
+  {
+    const DepthMap c(100, 100);
+    EXPECT_EQ(depthMapPoolBytes(), 0u);  // the 300 × 200 buffer went back to the system
+  }
+  EXPECT_EQ(depthMapPoolBytes(), size_t(100 * 100 * 4));
+}
+
 }  // namespace
 }  // namespace rastray
