@@ -24,6 +24,7 @@ constexpr const char* kSupportedExtensions[] = {
     "KHR_materials_ior",       "KHR_materials_emissive_strength",
     "KHR_mesh_quantization",   "KHR_draco_mesh_compression",
     "EXT_meshopt_compression", "KHR_meshopt_compression",
+    "KHR_texture_transform",
 };
 
 // The two names of meshopt compression: the vendor extension and its
@@ -185,6 +186,22 @@ class Checker {
     integer(*v, "texCoord", e, false);
     number(*v, "scale", e, false);
     number(*v, "strength", e, false);
+    if (const json* ext = member(*v, "extensions")) {
+      object(*ext, e + " extensions");
+      if (const json* t = member(*ext, "KHR_texture_transform")) {
+        const std::string te = e + " KHR_texture_transform";
+        object(*t, te);
+        numberArray(*t, "offset", te, 2, 2);
+        numberArray(*t, "scale", te, 2, 2);
+        floatNumber(*t, "rotation", te, false);
+        integer(*t, "texCoord", te, false);
+        for (const char* key : {"offset", "scale"})
+          if (const json* a = member(*t, key))
+            for (const json& x : *a)
+              if (std::abs(x.get<double>()) > double(std::numeric_limits<float>::max()))
+                fail(te, std::string("\"") + key + "\" is out of float range");
+      }
+    }
   }
 
   static std::string singular(const char* plural) {

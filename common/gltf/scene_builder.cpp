@@ -29,6 +29,10 @@ namespace {
 
 using json = nlohmann::json;
 
+// The KHR_texture_transform object of a textureInfo, or nullptr.
+const json* textureTransformOf(const json& textureInfo);
+int64_t texCoordOf(const json& textureInfo);
+
 class SceneBuilder {
  public:
   SceneBuilder(const std::string& path, const json& doc, const tinygltf::Model& model,
@@ -577,9 +581,23 @@ int64_t SceneBuilder::texCoordSetOf(const json& prim) const {
   if (!prim.contains("material")) return 0;
   const json& m = array("materials")[prim.at("material").get<size_t>()];
   if (m.contains("pbrMetallicRoughness") && m.at("pbrMetallicRoughness").contains("baseColorTexture"))
-    return get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0);
-  if (m.contains("emissiveTexture")) return get<int64_t>(m.at("emissiveTexture"), "texCoord", 0);
+    return texCoordOf(m.at("pbrMetallicRoughness").at("baseColorTexture"));
+  if (m.contains("emissiveTexture")) return texCoordOf(m.at("emissiveTexture"));
   return 0;
+}
+
+const json* textureTransformOf(const json& textureInfo) {
+  const auto ext = textureInfo.find("extensions");
+  if (ext == textureInfo.end() || !ext->contains("KHR_texture_transform")) return nullptr;
+  return &ext->at("KHR_texture_transform");
+}
+
+// A textureInfo's texcoord set: KHR_texture_transform's "texCoord"
+// overrides the textureInfo's own.
+int64_t texCoordOf(const json& textureInfo) {
+  const json* transform = textureTransformOf(textureInfo);
+  if (transform && transform->contains("texCoord")) return transform->at("texCoord").get<int64_t>();
+  return textureInfo.value("texCoord", int64_t(0));
 }
 
 SceneBuilder::VertexData SceneBuilder::readVertexData(const json& prim, const std::string& e,
@@ -845,10 +863,9 @@ void SceneBuilder::loadMaterials() {
       // One uv set per vertex (Scene::texcoords): the emissive texture must
       // read the base colour texture's set, or it is listed as ignored.
       const json& info = m.at("emissiveTexture");
-      const bool sameSet = !m.contains("pbrMetallicRoughness") ||
-                           !m.at("pbrMetallicRoughness").contains("baseColorTexture") ||
-                           get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0) ==
-                               get<int64_t>(info, "texCoord", 0);
+      const bool sameSet =
+          !m.contains("pbrMetallicRoughness") || !m.at("pbrMetallicRoughness").contains("baseColorTexture") ||
+          texCoordOf(m.at("pbrMetallicRoughness").at("baseColorTexture")) == texCoordOf(info);
       if (sameSet)
         mat.emissiveTexture = decodableTexture(info);
       else
@@ -882,9 +899,23 @@ void SceneBuilder::loadMaterials() {
 
 int32_t SceneBuilder::decodableTexture(const json& textureInfo) {
   const int32_t tex = textureInfo.at("index").get<int32_t>();
-  if (scene_.textures[size_t(tex)].image >= 0) return tex;
-  noteIgnored("texture without a decodable image", "textureInfo");
-  return -1;
+  if (scene_.textures[size_t(tex)].image < 0) {
+    noteIgnored("texture without a decodable image", "textureInfo");
+    return -1;
+  }
+  const json* transform = textureTransformOf(textureInfo);
+  if (!transform) return tex;
+  // KHR_texture_transform: a texture of this textureInfo's own, sharing
+  // the image (and its mip chain, TextureSet) and the sampler.
+  const auto pair = [&](const char* key, double fallback) {
+    const auto v = get<std::vector<double>>(*transform, key, {fallback, fallback});
+    return glm::dvec2(v[0], v[1]);
+  };
+  Texture t = scene_.textures[size_t(tex)];
+  t.transform = TextureTransform(pair("offset", 0.0), get(*transform, "rotation", 0.0), pair("scale", 1.0));
+  if (t.transform.identity) return tex;
+  scene_.textures.push_back(t);
+  return int32_t(scene_.textures.size() - 1);
 }
 
 // COLOR_0 (glTF 2.0 §3.7.2.1): VEC3 or VEC4, float or normalized unsigned
