@@ -195,11 +195,11 @@ class Checker {
         numberArray(*t, "scale", te, 2, 2);
         floatNumber(*t, "rotation", te, false);
         integer(*t, "texCoord", te, false);
-        for (const char* key : {"offset", "scale"})
-          if (const json* a = member(*t, key))
+        for (const char* field : {"offset", "scale"})
+          if (const json* a = member(*t, field))
             for (const json& x : *a)
               if (std::abs(x.get<double>()) > double(std::numeric_limits<float>::max()))
-                fail(te, std::string("\"") + key + "\" is out of float range");
+                fail(te, std::string("\"") + field + "\" is out of float range");
       }
     }
   }
