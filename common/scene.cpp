@@ -15,6 +15,13 @@ glm::dvec3 faceNormal(const Scene& scene, uint32_t instance, uint32_t tri) {
   return glm::cross(b - a, c - a);
 }
 
+TextureTransform::TextureTransform(glm::dvec2 offset_, double rotation, glm::dvec2 scale)
+    : offset(offset_), identity(offset_ == glm::dvec2(0.0) && rotation == 0.0 && scale == glm::dvec2(1.0)) {
+  const double c = std::cos(rotation), s = std::sin(rotation);
+  // Columns (c, −s) and (s, c): u' = c·u + s·v, v' = −s·u + c·v; then scale first.
+  linear = glm::dmat2(c, -s, s, c) * glm::dmat2(scale.x, 0.0, 0.0, scale.y);
+}
+
 bool isDegenerate(const Scene& scene, size_t storedTriangle) {
   const glm::uvec3 t = scene.triangles[storedTriangle];
   const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);

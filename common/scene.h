@@ -56,9 +56,31 @@ struct TextureImage {
   std::vector<uint8_t> rgba8;
 };
 
+// KHR_texture_transform of one textureInfo: the uv a texture is sampled at
+// is offset + R(rotation) · (scale ⊙ uv) (the extension's T·R·S), with R
+// as the glTF Sample Viewer and three.js apply it: u' = cos·u + sin·v,
+// v' = −sin·u + cos·v (rotation counter-clockwise in the image, whose
+// v axis points down). Kept in double: applied to the float uv in double,
+// rounded to float once (the texture wraps in double anyway).
+struct TextureTransform {
+  glm::dmat2 linear{1.0};  // rotation × scale; columns are GLM's
+  glm::dvec2 offset{0.0};
+  bool identity = true;
+
+  TextureTransform() = default;
+  TextureTransform(glm::dvec2 offset, double rotation, glm::dvec2 scale);
+  glm::vec2 apply(glm::vec2 uv) const { return identity ? uv : glm::vec2(linear * glm::dvec2(uv) + offset); }
+  // A uv difference (a footprint derivative): the linear part only.
+  glm::vec2 applyLinear(glm::vec2 d) const { return identity ? d : glm::vec2(linear * glm::dvec2(d)); }
+};
+
+// A texture as one textureInfo reads it: the loader gives every textureInfo
+// with a KHR_texture_transform a Texture of its own (same image and
+// sampler, its transform); TextureSet shares the image's mip chain.
 struct Texture {
   int32_t image = -1;  // index into Scene::images; -1: no decodable source
   TextureSampler sampler;
+  TextureTransform transform;
 };
 
 struct Material {

@@ -99,33 +99,46 @@ glm::vec4 unpremultiply(const glm::vec4& c) {
 TextureSet::TextureSet(const Scene& scene) {
   chains_.resize(scene.textures.size());
   samplers_.resize(scene.textures.size());
+  transforms_.resize(scene.textures.size());
+  std::vector<std::shared_ptr<const std::vector<MipLevel>>> byImage(scene.images.size());
   // Base colour and emissive textures are both sRGB colour: one chain
-  // serves a texture used as either.
+  // serves a texture used as either, and every texture of its image.
   for (const Material& m : scene.materials)
     for (const int32_t texture : {m.baseColorTexture, m.emissiveTexture}) {
       if (texture < 0) continue;
       const size_t t = size_t(texture);
       samplers_[t] = scene.textures[t].sampler;
-      if (!chains_[t].empty()) continue;
-      std::vector<MipLevel>& chain = chains_[t];
-      chain.push_back(decodeLevel0(scene.images[size_t(scene.textures[t].image)]));
-      while (chain.back().width > 1 || chain.back().height > 1) chain.push_back(halve(chain.back()));
+      transforms_[t] = scene.textures[t].transform;
+      if (chains_[t]) continue;
+      const size_t image = size_t(scene.textures[t].image);
+      if (!byImage[image]) {
+        std::vector<MipLevel> chain;
+        chain.push_back(decodeLevel0(scene.images[image]));
+        while (chain.back().width > 1 || chain.back().height > 1) chain.push_back(halve(chain.back()));
+        byImage[image] = std::make_shared<const std::vector<MipLevel>>(std::move(chain));
+      }
+      chains_[t] = byImage[image];
     }
 }
 
-size_t TextureSet::levelCount(int texture) const { return chains_[size_t(texture)].size(); }
+size_t TextureSet::levelCount(int texture) const { return chains_[size_t(texture)]->size(); }
 
 float TextureSet::levelOfDetail(int texture, const TextureFootprint& fp) const {
-  const MipLevel& l0 = chains_[size_t(texture)][0];
+  const MipLevel& l0 = (*chains_[size_t(texture)])[0];
+  // The footprint's derivatives map through the transform's linear part.
+  const TextureTransform& transform = transforms_[size_t(texture)];
+  const glm::vec2 dx = transform.applyLinear(fp.dUVdx), dy = transform.applyLinear(fp.dUVdy);
   const glm::vec2 size(float(l0.width), float(l0.height));
-  const float rho = std::max(glm::length(fp.dUVdx * size), glm::length(fp.dUVdy * size));
+  const float rho = std::max(glm::length(dx * size), glm::length(dy * size));
   return rho > 0.0f ? std::log2(rho) : -INFINITY;
 }
 
 glm::vec4 TextureSet::sample(int texture, glm::vec2 uv, const TextureFootprint& fp,
                              TextureFilter filter) const {
+  // KHR_texture_transform: uv affinely (the footprint in levelOfDetail).
+  uv = transforms_[size_t(texture)].apply(uv);
   if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
-  const std::vector<MipLevel>& chain = chains_[size_t(texture)];
+  const std::vector<MipLevel>& chain = *chains_[size_t(texture)];
   const TextureSampler& s = samplers_[size_t(texture)];
   if (filter == TextureFilter::Nearest) return unpremultiply(nearest(chain[0], uv, s));
   if (filter == TextureFilter::Bilinear) return unpremultiply(bilinear(chain[0], uv, s));

@@ -50,16 +50,22 @@ class TextureSet {
 
   bool empty() const { return chains_.empty(); }
   size_t levelCount(int texture) const;
-  const std::vector<MipLevel>& levels(int texture) const { return chains_[size_t(texture)]; }
+  const std::vector<MipLevel>& levels(int texture) const { return *chains_[size_t(texture)]; }
 
-  // Straight linear RGBA at uv for a footprint.
+  // Straight linear RGBA at uv (the surface's) for a footprint: the
+  // texture's transform (KHR_texture_transform, Texture::transform) maps uv
+  // and the footprint first, inside this one function both renderers use.
   glm::vec4 sample(int texture, glm::vec2 uv, const TextureFootprint& footprint, TextureFilter filter) const;
-  // The level of detail lambda for a footprint (for tests and `explain`).
+  // The level of detail lambda for a footprint in the surface's uv (the
+  // texture's transform applied here, as in sample).
   float levelOfDetail(int texture, const TextureFootprint& footprint) const;
 
  private:
-  std::vector<std::vector<MipLevel>> chains_;  // by texture index; empty for unused ones
+  // By texture index; textures of one image share its chain (textureInfos
+  // with a transform get textures of their own). Null for unused ones.
+  std::vector<std::shared_ptr<const std::vector<MipLevel>>> chains_;
   std::vector<TextureSampler> samplers_;
+  std::vector<TextureTransform> transforms_;
 };
 
 // A scene's TextureSet built once, on first use, and shared: every Shader

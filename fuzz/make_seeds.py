@@ -5,8 +5,9 @@ gltf_loader_fuzzer: the small self-contained glTF files of scenes/ and
 tests/data (valid, real-world and malformed: the malformed ones start the
 fuzzer next to every refusal the loader has), and GLB versions of the
 single-buffer data-URI files (the BIN chunk instead of base64), so both
-containers are seeded. A fuzzer input is one file: external buffers are
-never found, so files that need them are left out.
+containers are seeded, and Draco and meshopt twins of two of them (the
+draco and gltfpack packages' encoders). A fuzzer input is one file:
+external buffers are never found, so files that need them are left out.
 
 exr_reader_fuzzer: tiny renders by `rastray render` (flat half and float
 colour, deep) and oiiotool variants of them that other renderers write:
@@ -93,6 +94,25 @@ def gltf_seeds():
             if glb:
                 with open(os.path.join(out, prefix + name[:-5] + ".glb"), "wb") as f:
                     f.write(glb)
+    compressed_seeds(out)
+
+
+def compressed_seeds(out):
+    """Compressed twins of two small GLBs: KHR_draco_mesh_compression
+    (draco_transcoder), EXT_meshopt_compression over KHR_mesh_quantization
+    (gltfpack -c) and with the OCTAHEDRAL filter (gltfpack -cc), so the
+    fuzzer starts inside both decoders. Needs the draco and gltfpack
+    packages (scripts/setup.sh)."""
+    inputs = [os.path.join(ROOT, "tests", "data", "real-world", "Box.glb"), os.path.join(out, "cornell-box.glb")]
+    with tempfile.TemporaryDirectory() as tmp:
+        for path in inputs:
+            stem = os.path.basename(path)[:-4]
+            for prefix, command in (("draco-", ["draco_transcoder"]), ("meshopt-", ["gltfpack", "-c"]),
+                                    ("meshopt-cc-", ["gltfpack", "-cc"])):
+                target = os.path.join(tmp, prefix + stem + ".glb")
+                subprocess.run(command + ["-i", path, "-o", target], check=True, stdout=subprocess.DEVNULL)
+                if os.path.getsize(target) <= MAX_GLTF_SEED:
+                    shutil.copyfile(target, os.path.join(out, prefix + stem + ".glb"))
 
 
 def exr_seeds(rastray):

@@ -20,10 +20,16 @@ using json = nlohmann::json;
 constexpr int64_t kMaxZeroFilledElements = int64_t(1) << 24;
 
 constexpr const char* kSupportedExtensions[] = {
-    "KHR_lights_punctual",   "KHR_materials_transmission",
-    "KHR_materials_ior",     "KHR_materials_emissive_strength",
-    "KHR_mesh_quantization",
+    "KHR_lights_punctual",     "KHR_materials_transmission",
+    "KHR_materials_ior",       "KHR_materials_emissive_strength",
+    "KHR_mesh_quantization",   "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression", "KHR_meshopt_compression",
+    "KHR_texture_transform",
 };
+
+// The two names of meshopt compression: the vendor extension and its
+// Khronos successor share the bufferView and buffer schema.
+constexpr const char* kMeshoptExtensions[] = {"EXT_meshopt_compression", "KHR_meshopt_compression"};
 
 const char* typeName(const json& v) {
   switch (v.type()) {
@@ -180,6 +186,22 @@ class Checker {
     integer(*v, "texCoord", e, false);
     number(*v, "scale", e, false);
     number(*v, "strength", e, false);
+    if (const json* ext = member(*v, "extensions")) {
+      object(*ext, e + " extensions");
+      if (const json* t = member(*ext, "KHR_texture_transform")) {
+        const std::string te = e + " KHR_texture_transform";
+        object(*t, te);
+        numberArray(*t, "offset", te, 2, 2);
+        numberArray(*t, "scale", te, 2, 2);
+        floatNumber(*t, "rotation", te, false);
+        integer(*t, "texCoord", te, false);
+        for (const char* field : {"offset", "scale"})
+          if (const json* a = member(*t, field))
+            for (const json& x : *a)
+              if (std::abs(x.get<double>()) > double(std::numeric_limits<float>::max()))
+                fail(te, std::string("\"") + field + "\" is out of float range");
+      }
+    }
   }
 
   static std::string singular(const char* plural) {
@@ -234,6 +256,16 @@ bool isSupportedExtension(const std::string& name) {
   return false;
 }
 
+bool isMeshoptFallbackBuffer(const nlohmann::json& buffer) {
+  const auto ext = buffer.find("extensions");
+  if (ext == buffer.end() || !ext->is_object()) return false;
+  for (const char* name : kMeshoptExtensions) {
+    const auto m = ext->find(name);
+    if (m != ext->end() && m->is_object() && m->value("fallback", json(false)) == json(true)) return true;
+  }
+  return false;
+}
+
 std::string supportedExtensionList() {
   std::string s;
   for (const char* e : kSupportedExtensions) s += (s.empty() ? "" : ", ") + std::string(e);
@@ -271,8 +303,13 @@ void checkExtensionLists(const Checker& c, const json& doc) {
 
 // Buffers and views come first: accessors and images check their ranges
 // against the declared byte lengths, which tinygltf enforces on load.
-std::vector<int64_t> checkBuffers(const Checker& c, const json& doc, const GltfCheckContext& context) {
-  std::vector<int64_t> bufferLength;
+struct BufferRanges {
+  std::vector<int64_t> length;
+  std::vector<bool> fallback;  // a meshopt fallback buffer: never read
+};
+
+BufferRanges checkBuffers(const Checker& c, const json& doc, const GltfCheckContext& context) {
+  BufferRanges r;
   if (const json* buffers = c.objectArray(doc, "buffers", "buffers")) {
     for (size_t i = 0; i < buffers->size(); ++i) {
       const std::string e = "buffer " + std::to_string(i);
@@ -280,25 +317,94 @@ std::vector<int64_t> checkBuffers(const Checker& c, const json& doc, const GltfC
       const int64_t length = c.integer(b, "byteLength", e, true);
       if (length < 1) c.fail(e, "\"byteLength\" must be at least 1");
       const std::string uri = c.string(b, "uri", e, false);
-      if (!c.member(b, "uri")) {
+      if (const json* ext = c.member(b, "extensions")) {
+        c.object(*ext, e + " extensions");
+        for (const char* name : kMeshoptExtensions)
+          if (const json* m = c.member(*ext, name)) {
+            c.object(*m, e + " " + name);
+            c.boolean(*m, "fallback", e + " " + name);
+          }
+      }
+      const bool fallback = isMeshoptFallbackBuffer(b);
+      // A fallback buffer's bytes are never read (only compressed views
+      // name it), so it may have no data anywhere.
+      if (!c.member(b, "uri") && !fallback) {
         if (!(context.isGlb && i == 0))
           c.fail(e, "has no \"uri\" (only buffer 0 of a .glb file may use the BIN chunk)");
         if (uint64_t(length) > context.glbBinSize)
           c.fail(e, "byteLength " + std::to_string(length) + " exceeds the GLB BIN chunk (" +
                         std::to_string(context.glbBinSize) + " bytes)");
       }
-      bufferLength.push_back(length);
+      r.length.push_back(length);
+      r.fallback.push_back(fallback);
     }
   }
-  return bufferLength;
+  return r;
 }
 
-// Byte length and stride (0: tightly packed) of every bufferView.
+// Byte length and stride (0: tightly packed) of every bufferView, and
+// whether its bytes come from a meshopt decoder.
 struct ViewRanges {
   std::vector<int64_t> length, stride;
+  std::vector<bool> compressed;
 };
 
-ViewRanges checkBufferViews(const Checker& c, const json& doc, const std::vector<int64_t>& bufferLength) {
+// An EXT_/KHR_meshopt_compression bufferView extension: the compressed
+// range lies in a buffer with data, and the decoded elements (count ×
+// byteStride, in a mode and filter libmeshoptimizer decodes) fill the
+// bufferView exactly, so accessors checked against the view stay inside
+// the decoded bytes.
+void checkMeshoptView(const Checker& c, const json& ext, const std::string& e, const BufferRanges& buffers,
+                      int64_t viewLength, int64_t viewStride) {
+  c.object(ext, e);
+  const int64_t buffer = c.index(ext, "buffer", e, "buffers", true);
+  if (buffers.fallback[size_t(buffer)])
+    c.fail(e, "\"buffer\" refers to fallback buffer " + std::to_string(buffer) + ", which holds no data");
+  const int64_t offset = c.integer(ext, "byteOffset", e, false, 0);
+  const int64_t length = c.integer(ext, "byteLength", e, true);
+  const int64_t stride = c.integer(ext, "byteStride", e, true);
+  const int64_t count = c.integer(ext, "count", e, true);
+  const std::string mode = c.string(ext, "mode", e, true);
+  const std::string filter = c.member(ext, "filter") ? c.string(ext, "filter", e, false) : "NONE";
+  if (!fits(offset, length, buffers.length[size_t(buffer)]))
+    c.fail(e, "compressed bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) +
+                  ") lie outside buffer " + std::to_string(buffer) + " (" +
+                  std::to_string(buffers.length[size_t(buffer)]) + " bytes)");
+  if (mode == "ATTRIBUTES") {
+    if (stride < 4 || stride > 256 || stride % 4 != 0)
+      c.fail(e, "\"byteStride\" " + std::to_string(stride) +
+                    " must be a multiple of 4 in [4, 256] for ATTRIBUTES");
+  } else if (mode == "TRIANGLES" || mode == "INDICES") {
+    if (stride != 2 && stride != 4)
+      c.fail(e, "\"byteStride\" " + std::to_string(stride) + " must be 2 or 4 for " + mode);
+    if (mode == "TRIANGLES" && count % 3 != 0)
+      c.fail(e, "\"count\" " + std::to_string(count) + " must be a multiple of 3 for TRIANGLES");
+  } else {
+    c.fail(e, "\"mode\" \"" + mode + "\" is not ATTRIBUTES, TRIANGLES or INDICES");
+  }
+  if (filter != "NONE") {
+    const bool ok =
+        mode == "ATTRIBUTES" && ((filter == "OCTAHEDRAL" && (stride == 4 || stride == 8)) ||
+                                 (filter == "QUATERNION" && stride == 8) || filter == "EXPONENTIAL");
+    if (filter != "OCTAHEDRAL" && filter != "QUATERNION" && filter != "EXPONENTIAL")
+      c.fail(
+          e,
+          "\"filter\" \"" + filter +
+              "\" is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL (the filters libmeshoptimizer decodes)");
+    if (!ok)
+      c.fail(e, "\"filter\" " + filter + " cannot apply to mode " + mode + " with byteStride " +
+                    std::to_string(stride));
+  }
+  if (count < 1 || count > (int64_t(1) << 32) || stride * count != viewLength)
+    c.fail(e, std::to_string(count) + " elements of " + std::to_string(stride) +
+                  " bytes do not fill the bufferView's byteLength " + std::to_string(viewLength));
+  if (viewStride != 0 && viewStride != stride)
+    c.fail(e, "\"byteStride\" " + std::to_string(stride) + " differs from the bufferView's " +
+                  std::to_string(viewStride));
+}
+
+ViewRanges checkBufferViews(const Checker& c, const json& doc, const BufferRanges& buffers) {
+  const std::vector<int64_t>& bufferLength = buffers.length;
   ViewRanges r;
   if (const json* views = c.objectArray(doc, "bufferViews", "bufferViews")) {
     for (size_t i = 0; i < views->size(); ++i) {
@@ -316,14 +422,59 @@ ViewRanges checkBufferViews(const Checker& c, const json& doc, const std::vector
         c.fail(e, "bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) +
                       ") lie outside buffer " + std::to_string(buffer) + " (" +
                       std::to_string(bufferLength[size_t(buffer)]) + " bytes)");
+      const json* meshopt = nullptr;
+      if (const json* ext = c.member(v, "extensions")) {
+        c.object(*ext, e + " extensions");
+        for (const char* name : kMeshoptExtensions)
+          if (const json* m = c.member(*ext, name)) {
+            if (meshopt) c.fail(e, "has both EXT_meshopt_compression and KHR_meshopt_compression");
+            meshopt = m;
+            checkMeshoptView(c, *m, e + " " + name, buffers, length, stride);
+          }
+      }
+      if (buffers.fallback[size_t(buffer)] && !meshopt)
+        c.fail(e, "refers to fallback buffer " + std::to_string(buffer) +
+                      " without a meshopt compression extension (a fallback buffer holds no data)");
       r.length.push_back(length);
       r.stride.push_back(stride);
+      r.compressed.push_back(meshopt != nullptr);
     }
   }
   return r;
 }
 
+// The accessors whose data a KHR_draco_mesh_compression stream holds: the
+// attributes it lists and the indices of its primitive. Their counts come
+// from the JSON as for any accessor; the decoder must produce exactly
+// them (scene_builder.cpp).
+std::vector<bool> dracoAccessors(const json& doc) {
+  std::vector<bool> draco(doc.contains("accessors") && doc["accessors"].is_array() ? doc["accessors"].size()
+                                                                                   : 0);
+  const auto mark = [&](const json& index) {
+    if (index.is_number_unsigned() && index.get<uint64_t>() < draco.size()) draco[index.get<size_t>()] = true;
+  };
+  const auto meshes = doc.find("meshes");
+  if (meshes == doc.end() || !meshes->is_array()) return draco;
+  for (const json& m : *meshes) {
+    if (!m.is_object() || !m.contains("primitives") || !m["primitives"].is_array()) continue;
+    for (const json& p : m["primitives"]) {
+      if (!p.is_object() || !p.contains("extensions") || !p["extensions"].is_object() ||
+          !p["extensions"].contains("KHR_draco_mesh_compression"))
+        continue;
+      const json& ext = p["extensions"]["KHR_draco_mesh_compression"];
+      if (p.contains("indices")) mark(p["indices"]);
+      if (!ext.is_object() || !ext.contains("attributes") || !ext["attributes"].is_object() ||
+          !p.contains("attributes") || !p["attributes"].is_object())
+        continue;
+      for (auto it = ext["attributes"].begin(); it != ext["attributes"].end(); ++it)
+        if (p["attributes"].contains(it.key())) mark(p["attributes"][it.key()]);
+    }
+  }
+  return draco;
+}
+
 void checkAccessors(const Checker& c, const json& doc, const ViewRanges& views) {
+  const std::vector<bool> draco = dracoAccessors(doc);
   if (const json* accessors = c.objectArray(doc, "accessors", "accessors")) {
     for (size_t i = 0; i < accessors->size(); ++i) {
       const std::string e = "accessor " + std::to_string(i);
@@ -338,7 +489,9 @@ void checkAccessors(const Checker& c, const json& doc, const ViewRanges& views) 
       const int64_t count = c.integer(a, "count", e, true);
       if (count < 1) c.fail(e, "\"count\" must be at least 1");
       if (count > (int64_t(1) << 32)) c.fail(e, "\"count\" " + std::to_string(count) + " is too large");
-      if (view < 0 && count > kMaxZeroFilledElements)
+      // A Draco accessor's elements are decoded, not zero-filled: the
+      // flattened scene's memory estimate bounds them instead.
+      if (view < 0 && !draco[i] && count > kMaxZeroFilledElements)
         c.fail(e, "\"count\" " + std::to_string(count) +
                       " is too large for an accessor without a bufferView (at most " +
                       std::to_string(kMaxZeroFilledElements) + ")");
@@ -388,7 +541,7 @@ void checkAccessors(const Checker& c, const json& doc, const ViewRanges& views) 
   }
 }
 
-void checkImagesAndTextures(const Checker& c, const json& doc) {
+void checkImagesAndTextures(const Checker& c, const json& doc, const ViewRanges& views) {
   if (const json* images = c.objectArray(doc, "images", "images")) {
     for (size_t i = 0; i < images->size(); ++i) {
       const std::string e = "image " + std::to_string(i);
@@ -397,6 +550,9 @@ void checkImagesAndTextures(const Checker& c, const json& doc) {
       c.string(im, "mimeType", e, false);
       const int64_t view = c.index(im, "bufferView", e, "bufferViews");
       if (view < 0 && !c.member(im, "uri")) c.fail(e, "has neither \"uri\" nor \"bufferView\"");
+      // tinygltf decodes images from the buffer's bytes as stored.
+      if (view >= 0 && views.compressed[size_t(view)])
+        c.fail(e, "bufferView " + std::to_string(view) + " is meshopt-compressed; images cannot be");
     }
   }
   if (const json* samplers = c.objectArray(doc, "samplers", "samplers")) {
@@ -471,7 +627,28 @@ void checkMaterials(const Checker& c, const json& doc) {
   }
 }
 
-void checkMeshes(const Checker& c, const json& doc) {
+// KHR_draco_mesh_compression on a primitive: the stream lies in a plain
+// bufferView, and every attribute it lists is one of the primitive's.
+// Draco decodes triangle lists, with indices.
+void checkDraco(const Checker& c, const json& draco, const std::string& e, const json& attributes,
+                int64_t indices, int64_t mode, const ViewRanges& views) {
+  c.object(draco, e);
+  const int64_t view = c.index(draco, "bufferView", e, "bufferViews", true);
+  if (views.compressed[size_t(view)])
+    c.fail(e, "bufferView " + std::to_string(view) + " is meshopt-compressed; a Draco stream cannot be");
+  const json* list = c.member(draco, "attributes");
+  if (!list) c.fail(e, "\"attributes\" is missing");
+  c.object(*list, e + " attributes");
+  for (auto it = list->begin(); it != list->end(); ++it) {
+    c.integer(*list, it.key().c_str(), e + " attributes", true);
+    if (!attributes.contains(it.key()))
+      c.fail(e + " attributes", "\"" + it.key() + "\" is not an attribute of the primitive");
+  }
+  if (mode > 4) c.fail(e, "\"mode\" " + std::to_string(mode) + ": Draco decodes TRIANGLES (4) only");
+  if (mode == 4 && indices < 0) c.fail(e, "the primitive has no \"indices\" for the decoded faces");
+}
+
+void checkMeshes(const Checker& c, const json& doc, const ViewRanges& views) {
   if (const json* meshes = c.objectArray(doc, "meshes", "meshes")) {
     for (size_t i = 0; i < meshes->size(); ++i) {
       const std::string e = "mesh " + std::to_string(i);
@@ -488,10 +665,15 @@ void checkMeshes(const Checker& c, const json& doc) {
         c.object(*attributes, pe + " attributes");
         for (auto it = attributes->begin(); it != attributes->end(); ++it)
           c.index(*attributes, it.key().c_str(), pe + " attributes", "accessors");
-        c.index(prim, "indices", pe, "accessors");
+        const int64_t indices = c.index(prim, "indices", pe, "accessors");
         c.index(prim, "material", pe, "materials");
         const int64_t mode = c.integer(prim, "mode", pe, false, 4);
         if (mode > 6) c.fail(pe, "\"mode\" " + std::to_string(mode) + " is not a glTF primitive mode");
+        if (const json* ext = c.member(prim, "extensions")) {
+          c.object(*ext, pe + " extensions");
+          if (const json* draco = c.member(*ext, "KHR_draco_mesh_compression"))
+            checkDraco(c, *draco, pe + " KHR_draco_mesh_compression", *attributes, indices, mode, views);
+        }
       }
     }
   }
@@ -644,12 +826,12 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
 
   checkAsset(c, doc);
   checkExtensionLists(c, doc);
-  const std::vector<int64_t> bufferLength = checkBuffers(c, doc, context);
-  const ViewRanges views = checkBufferViews(c, doc, bufferLength);
+  const BufferRanges buffers = checkBuffers(c, doc, context);
+  const ViewRanges views = checkBufferViews(c, doc, buffers);
   checkAccessors(c, doc, views);
-  checkImagesAndTextures(c, doc);
+  checkImagesAndTextures(c, doc, views);
   checkMaterials(c, doc);
-  checkMeshes(c, doc);
+  checkMeshes(c, doc, views);
   checkCameras(c, doc);
   const size_t lightCount = checkLights(c, doc);
   checkNodes(c, doc, lightCount);

@@ -35,4 +35,9 @@ int64_t componentCount(const std::string& type);
 bool isSupportedExtension(const std::string& name);
 std::string supportedExtensionList();
 
+// Whether a buffer is an EXT_/KHR_meshopt_compression fallback buffer
+// ("fallback": true): only compressed bufferViews name it, its bytes are
+// never read, and it may have no uri. False for anything malformed.
+bool isMeshoptFallbackBuffer(const nlohmann::json& buffer);
+
 }  // namespace rastray

@@ -10,6 +10,7 @@
 //    accessors with bounds already proven and rejecting NaN/Inf data.
 #include "common/gltf/loader.h"
 
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <utility>
@@ -29,6 +30,12 @@ namespace rastray {
 namespace {
 
 using json = nlohmann::json;
+
+uint32_t readLittleU32(const std::vector<uint8_t>& bytes, size_t offset) {
+  uint32_t v;
+  std::memcpy(&v, bytes.data() + offset, 4);
+  return v;  // glTF is little-endian, as is every platform we build for
+}
 
 std::string firstLine(const std::string& text) {
   std::istringstream in(text);
@@ -88,6 +95,55 @@ bool loadImageWithinBudget(tinygltf::Image* image, const int index, std::string*
   return tinygltf::LoadImageData(image, index, err, warn, reqWidth, reqHeight, bytes, size, nullptr);
 }
 
+// tinygltf only loads the buffers and images here (the scene builder reads
+// the rest from the checked JSON), but it parses everything and refuses
+// two things compressed geometry has: a buffer without data (a meshopt
+// fallback buffer, never read: check.cpp lets only compressed bufferViews
+// name it, and their bytes come from the decoder) and index accessors
+// without a bufferView (a Draco primitive's, decoded from its stream).
+// tinygltf is then given a copy of the document in which each fallback
+// buffer without a uri is one zero byte and Draco primitives have no
+// "indices". Returns false when neither occurs (the document goes to
+// tinygltf as it is).
+bool documentForTinygltf(const GltfDocument& d, std::vector<uint8_t>& glb, std::string& text) {
+  json copy;
+  const auto edit = [&]() -> json& {
+    if (copy.is_null()) copy = d.json;
+    return copy;
+  };
+  if (const auto buffers = d.json.find("buffers"); buffers != d.json.end())
+    for (size_t i = 0; i < buffers->size(); ++i) {
+      const json& b = (*buffers)[i];
+      if (!isMeshoptFallbackBuffer(b) || b.contains("uri")) continue;
+      edit()["buffers"][i]["byteLength"] = 1;
+      copy["buffers"][i]["uri"] = "data:application/octet-stream;base64,AA==";
+    }
+  if (const auto meshes = d.json.find("meshes"); meshes != d.json.end())
+    for (size_t m = 0; m < meshes->size(); ++m) {
+      const json& prims = (*meshes)[m].at("primitives");
+      for (size_t p = 0; p < prims.size(); ++p)
+        if (prims[p].contains("extensions") &&
+            prims[p].at("extensions").contains("KHR_draco_mesh_compression") && prims[p].contains("indices"))
+          edit()["meshes"][m]["primitives"][p].erase("indices");
+    }
+  if (copy.is_null()) return false;
+  text = copy.dump();
+  if (!d.context.isGlb) return true;
+  // The same container around the new JSON chunk (padded with spaces to
+  // 4 bytes, as the format requires) and the original BIN chunk.
+  text.append((4 - text.size() % 4) % 4, ' ');
+  const size_t binAt = 20 + size_t(readLittleU32(d.bytes, 12));
+  const size_t total = 20 + text.size() + (d.bytes.size() - binAt);
+  if (total > UINT32_MAX) throw InputError(d.context.file, "", "file is larger than 4 GiB");
+  glb.assign(d.bytes.begin(), d.bytes.begin() + 12);
+  const uint32_t header[3] = {uint32_t(total), uint32_t(text.size()), 0x4E4F534A};  // length, JSON chunk
+  glb.resize(20);
+  std::memcpy(glb.data() + 8, header, sizeof header);
+  glb.insert(glb.end(), text.begin(), text.end());
+  glb.insert(glb.end(), d.bytes.begin() + binAt, d.bytes.end());
+  return true;
+}
+
 // Step 3: tinygltf loads the buffers and decodes the images. The document
 // is sound by now, so its remaining failures are about resources: missing
 // files, bad data URIs, undecodable images.
@@ -104,11 +160,16 @@ void loadResources(const GltfDocument& d, tinygltf::Model& model, const MemoryBu
   loader.SetImageLoader(&loadImageWithinBudget, &images);
   std::string err, warn;
   if (d.bytes.size() > UINT32_MAX) throw InputError(path, "", "file is larger than 4 GiB");
+  std::vector<uint8_t> glb = {};
+  std::string text;
+  const bool rewritten = documentForTinygltf(d, glb, text);
+  const std::vector<uint8_t>& bytes = rewritten ? glb : d.bytes;
+  const std::string& jsonText = rewritten ? text : d.jsonText;
   const bool ok =
       d.context.isGlb
-          ? loader.LoadBinaryFromMemory(&model, &err, &warn, d.bytes.data(), unsigned(d.bytes.size()),
+          ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()),
                                         baseDir.empty() ? "." : baseDir)
-          : loader.LoadASCIIFromString(&model, &err, &warn, d.jsonText.data(), unsigned(d.jsonText.size()),
+          : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(), unsigned(jsonText.size()),
                                        baseDir.empty() ? "." : baseDir);
   if (!ok && images.refusedImage >= 0)
     checkMemory(images.refusal, budget, path, "image " + std::to_string(images.refusedImage),
@@ -144,7 +205,8 @@ void loadResources(const GltfDocument& d, tinygltf::Model& model, const MemoryBu
       model.images.size() != d.json.value("images", json::array()).size())
     throw InputError(path, "", "tinygltf loaded a different number of buffers or images than the file lists");
   for (size_t i = 0; i < model.buffers.size(); ++i)
-    if (model.buffers[i].data.size() < d.json.at("buffers")[i].at("byteLength").get<size_t>())
+    if (!isMeshoptFallbackBuffer(d.json.at("buffers")[i]) &&
+        model.buffers[i].data.size() < d.json.at("buffers")[i].at("byteLength").get<size_t>())
       throw InputError(path, "buffer " + std::to_string(i), "is shorter than its byteLength");
 }
 

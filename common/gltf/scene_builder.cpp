@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 
 #include <tiny_gltf.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -17,6 +18,7 @@
 
 #include "common/error.h"
 #include "common/gltf/check.h"
+#include "common/gltf/compression.h"
 #include "common/gltf/document.h"
 #include "common/math_constants.h"
 #include "common/memory_budget.h"
@@ -26,6 +28,10 @@ namespace rastray {
 namespace {
 
 using json = nlohmann::json;
+
+// The KHR_texture_transform object of a textureInfo, or nullptr.
+const json* textureTransformOf(const json& textureInfo);
+int64_t texCoordOf(const json& textureInfo);
 
 class SceneBuilder {
  public:
@@ -87,6 +93,16 @@ class SceneBuilder {
   std::vector<double> readAccessor(int64_t index, const std::string& element,
                                    std::initializer_list<const char*> types, size_t* components) const;
   std::vector<uint32_t> readIndices(int64_t index, const std::string& element) const;
+  // The bytes of bufferView `view`: the decoded bytes of a meshopt-
+  // compressed view, else its range of the buffer tinygltf loaded.
+  const uint8_t* viewBytes(int64_t view) const;
+  // Decodes every meshopt-compressed bufferView (decodedViews_), after
+  // checking their total size against the budget.
+  void decodeMeshoptViews();
+  // Decodes a KHR_draco_mesh_compression primitive into dracoAccessors_:
+  // the decoded values of its attribute and index accessors, which
+  // readAccessor then reads instead of the (absent) bufferViews.
+  void decodeDraco(const json& prim, const std::string& element);
 
   const std::string& path_;
   const json& doc_;
@@ -94,6 +110,8 @@ class SceneBuilder {
   const MemoryBudget& budget_;
   Scene scene_;
   int64_t defaultMaterial_ = -1;
+  std::map<int64_t, std::vector<uint8_t>> decodedViews_;  // by bufferView
+  std::map<int64_t, DracoAttribute> dracoAccessors_;      // by accessor; the primitive being added
 };
 
 // Component read with glTF normalisation rules (glTF 2.0 §3.11).
@@ -156,16 +174,26 @@ std::vector<double> SceneBuilder::readAccessor(int64_t index, const std::string&
 
   auto readView = [&](int64_t view, size_t byteOffset, size_t stride, size_t elements,
                       size_t elementComponents, int64_t ctype, bool norm, double* dst) {
-    const json& v = array("bufferViews")[size_t(view)];
-    const auto& data = model_.buffers[v.at("buffer").get<size_t>()].data;
-    const size_t base = get<size_t>(v, "byteOffset", 0) + byteOffset;
+    const uint8_t* data = viewBytes(view) + byteOffset;
     for (size_t e = 0; e < elements; ++e)
       for (size_t c = 0; c < elementComponents; ++c)
         dst[e * elementComponents + c] =
-            readComponent(data.data() + base + e * stride + c * componentBytes(ctype), ctype, norm);
+            readComponent(data + e * stride + c * componentBytes(ctype), ctype, norm);
   };
 
-  if (a.contains("bufferView")) {
+  const auto draco = dracoAccessors_.find(index);
+  if (draco != dracoAccessors_.end()) {
+    // Decoded by libdraco: the same type, count and value checks as data
+    // read from a bufferView.
+    const DracoAttribute& d = draco->second;
+    if (d.components != n)
+      fail(ae, "the Draco stream has " + std::to_string(d.components) + " components per element, type " +
+                   type + " has " + std::to_string(n));
+    if (d.values.size() != out.size())
+      fail(ae, "the Draco stream decodes " + std::to_string(d.values.size() / n) +
+                   " elements, \"count\" is " + std::to_string(count));
+    out = d.values;
+  } else if (a.contains("bufferView")) {
     const int64_t view = a.at("bufferView").get<int64_t>();
     const size_t stride = get<size_t>(array("bufferViews")[size_t(view)], "byteStride", 0);
     readView(view, get<size_t>(a, "byteOffset", 0), stride ? stride : n * cbytes, count, n, componentType,
@@ -195,6 +223,85 @@ std::vector<double> SceneBuilder::readAccessor(int64_t index, const std::string&
       fail(ae, "element " + std::to_string(i / n) + " component " + std::to_string(i % n) + " is " +
                    (std::isnan(out[i]) ? "NaN" : "infinite"));
   return out;
+}
+
+const uint8_t* SceneBuilder::viewBytes(int64_t view) const {
+  const auto decoded = decodedViews_.find(view);
+  if (decoded != decodedViews_.end()) return decoded->second.data();
+  const json& v = array("bufferViews")[size_t(view)];
+  return model_.buffers[v.at("buffer").get<size_t>()].data.data() + get<size_t>(v, "byteOffset", 0);
+}
+
+// The meshopt extension of bufferView `v`, or nullptr.
+const json* meshoptExtension(const json& v) {
+  const auto ext = v.find("extensions");
+  if (ext == v.end()) return nullptr;
+  for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"})
+    if (ext->contains(name)) return &ext->at(name);
+  return nullptr;
+}
+
+void SceneBuilder::decodeMeshoptViews() {
+  const json& views = array("bufferViews");
+  // check.cpp: count × byteStride is the view's byteLength, which a
+  // fallback buffer only declares; a small file can declare gigabytes.
+  uint64_t decodedBytes = 0;
+  for (const json& v : views)
+    if (meshoptExtension(v)) decodedBytes = addSat(decodedBytes, v.at("byteLength").get<uint64_t>());
+  if (decodedBytes == 0) return;
+  MemoryEstimate estimate;
+  estimate.add("loaded file", currentRssBytes());
+  estimate.add("decoded meshopt bufferViews", decodedBytes);
+  checkMemory(estimate, budget_, path_, "bufferViews", "decoding meshopt-compressed bufferViews");
+  for (size_t i = 0; i < views.size(); ++i) {
+    const json* m = meshoptExtension(views[i]);
+    if (!m) continue;
+    MeshoptView view;
+    const std::string mode = m->at("mode").get<std::string>();
+    view.mode = mode == "ATTRIBUTES"  ? MeshoptView::Mode::Attributes
+                : mode == "TRIANGLES" ? MeshoptView::Mode::Triangles
+                                      : MeshoptView::Mode::Indices;
+    const std::string filter = get<std::string>(*m, "filter", "NONE");
+    view.filter = filter == "OCTAHEDRAL"    ? MeshoptView::Filter::Octahedral
+                  : filter == "QUATERNION"  ? MeshoptView::Filter::Quaternion
+                  : filter == "EXPONENTIAL" ? MeshoptView::Filter::Exponential
+                                            : MeshoptView::Filter::None;
+    view.count = m->at("count").get<size_t>();
+    view.byteStride = m->at("byteStride").get<size_t>();
+    const auto& source = model_.buffers[m->at("buffer").get<size_t>()].data;
+    decodedViews_[int64_t(i)] =
+        decodeMeshoptView(view, source.data() + get<size_t>(*m, "byteOffset", 0),
+                          m->at("byteLength").get<size_t>(), path_, "bufferView " + std::to_string(i));
+  }
+}
+
+void SceneBuilder::decodeDraco(const json& prim, const std::string& element) {
+  dracoAccessors_.clear();
+  const json& draco = prim.at("extensions").at("KHR_draco_mesh_compression");
+  const json& attributes = prim.at("attributes");
+  std::map<std::string, DracoAttributeRequest> requests;
+  for (auto it = draco.at("attributes").begin(); it != draco.at("attributes").end(); ++it) {
+    const json& a = array("accessors")[attributes.at(it.key()).get<size_t>()];
+    requests[it.key()] = {it.value().get<int64_t>(), a.at("componentType").get<int64_t>(),
+                          get(a, "normalized", false)};
+  }
+  const json& v = array("bufferViews")[draco.at("bufferView").get<size_t>()];
+  DracoPrimitive decoded = decodeDracoPrimitive(viewBytes(draco.at("bufferView").get<int64_t>()),
+                                                v.at("byteLength").get<size_t>(), requests, path_, element);
+  for (auto& [name, values] : decoded.attributes) {
+    const int64_t accessor = attributes.at(name).get<int64_t>();
+    if (dracoAccessors_.count(accessor))
+      fail(element + " KHR_draco_mesh_compression",
+           "accessor " + std::to_string(accessor) + " is named by two Draco attributes");
+    dracoAccessors_[accessor] = std::move(values);
+  }
+  const int64_t indices = prim.at("indices").get<int64_t>();
+  if (dracoAccessors_.count(indices))
+    fail(element + " KHR_draco_mesh_compression",
+         "accessor " + std::to_string(indices) + " is both the indices and a Draco attribute");
+  DracoAttribute& faces = dracoAccessors_[indices];
+  faces.components = 1;
+  faces.values.assign(decoded.indices.begin(), decoded.indices.end());
 }
 
 std::vector<uint32_t> SceneBuilder::readIndices(int64_t index, const std::string& element) const {
@@ -442,9 +549,16 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
     scene_.instances.push_back(inst);
     return;
   }
+  // Draco streams decode per instance: a mesh instanced by several nodes
+  // decodes once for each, so only one primitive's data is held at a time
+  // (the flattened scene's memory estimate counts one).
+  const bool draco =
+      prim.contains("extensions") && prim.at("extensions").contains("KHR_draco_mesh_compression");
+  if (draco) decodeDraco(prim, e);
   const VertexData vertices = readVertexData(prim, e, inst);
   appendVertices(inst, vertices, world, e);
   appendTriangles(inst, prim, e);
+  dracoAccessors_.clear();
   scene_.instances.push_back(inst);
 }
 
@@ -467,9 +581,23 @@ int64_t SceneBuilder::texCoordSetOf(const json& prim) const {
   if (!prim.contains("material")) return 0;
   const json& m = array("materials")[prim.at("material").get<size_t>()];
   if (m.contains("pbrMetallicRoughness") && m.at("pbrMetallicRoughness").contains("baseColorTexture"))
-    return get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0);
-  if (m.contains("emissiveTexture")) return get<int64_t>(m.at("emissiveTexture"), "texCoord", 0);
+    return texCoordOf(m.at("pbrMetallicRoughness").at("baseColorTexture"));
+  if (m.contains("emissiveTexture")) return texCoordOf(m.at("emissiveTexture"));
   return 0;
+}
+
+const json* textureTransformOf(const json& textureInfo) {
+  const auto ext = textureInfo.find("extensions");
+  if (ext == textureInfo.end() || !ext->contains("KHR_texture_transform")) return nullptr;
+  return &ext->at("KHR_texture_transform");
+}
+
+// A textureInfo's texcoord set: KHR_texture_transform's "texCoord"
+// overrides the textureInfo's own.
+int64_t texCoordOf(const json& textureInfo) {
+  const json* transform = textureTransformOf(textureInfo);
+  if (transform && transform->contains("texCoord")) return transform->at("texCoord").get<int64_t>();
+  return textureInfo.value("texCoord", int64_t(0));
 }
 
 SceneBuilder::VertexData SceneBuilder::readVertexData(const json& prim, const std::string& e,
@@ -735,10 +863,9 @@ void SceneBuilder::loadMaterials() {
       // One uv set per vertex (Scene::texcoords): the emissive texture must
       // read the base colour texture's set, or it is listed as ignored.
       const json& info = m.at("emissiveTexture");
-      const bool sameSet = !m.contains("pbrMetallicRoughness") ||
-                           !m.at("pbrMetallicRoughness").contains("baseColorTexture") ||
-                           get<int64_t>(m.at("pbrMetallicRoughness").at("baseColorTexture"), "texCoord", 0) ==
-                               get<int64_t>(info, "texCoord", 0);
+      const bool sameSet =
+          !m.contains("pbrMetallicRoughness") || !m.at("pbrMetallicRoughness").contains("baseColorTexture") ||
+          texCoordOf(m.at("pbrMetallicRoughness").at("baseColorTexture")) == texCoordOf(info);
       if (sameSet)
         mat.emissiveTexture = decodableTexture(info);
       else
@@ -772,9 +899,23 @@ void SceneBuilder::loadMaterials() {
 
 int32_t SceneBuilder::decodableTexture(const json& textureInfo) {
   const int32_t tex = textureInfo.at("index").get<int32_t>();
-  if (scene_.textures[size_t(tex)].image >= 0) return tex;
-  noteIgnored("texture without a decodable image", "textureInfo");
-  return -1;
+  if (scene_.textures[size_t(tex)].image < 0) {
+    noteIgnored("texture without a decodable image", "textureInfo");
+    return -1;
+  }
+  const json* transform = textureTransformOf(textureInfo);
+  if (!transform) return tex;
+  // KHR_texture_transform: a texture of this textureInfo's own, sharing
+  // the image (and its mip chain, TextureSet) and the sampler.
+  const auto pair = [&](const char* key, double fallback) {
+    const auto v = get<std::vector<double>>(*transform, key, {fallback, fallback});
+    return glm::dvec2(v[0], v[1]);
+  };
+  Texture t = scene_.textures[size_t(tex)];
+  t.transform = TextureTransform(pair("offset", 0.0), get(*transform, "rotation", 0.0), pair("scale", 1.0));
+  if (t.transform.identity) return tex;
+  scene_.textures.push_back(t);
+  return int32_t(scene_.textures.size() - 1);
 }
 
 // COLOR_0 (glTF 2.0 §3.7.2.1): VEC3 or VEC4, float or normalized unsigned
@@ -879,6 +1020,7 @@ Scene SceneBuilder::build() {
   scene_.stats.nodes = uint32_t(array("nodes").size());
   scene_.stats.meshes = uint32_t(array("meshes").size());
   scene_.stats.cameras = uint32_t(array("cameras").size());
+  decodeMeshoptViews();
   loadTextures();
   loadMaterials();
   std::vector<int64_t> parent;

@@ -333,11 +333,25 @@ def malformed():
     files["scene-node-not-root.gltf"] = text(d)
 
     # Asset and extensions.
-    files["extension-draco.gltf"] = text(quad_doc(
-        extensionsUsed=["KHR_draco_mesh_compression"],
-        extensionsRequired=["KHR_draco_mesh_compression"]))
-    files["extension-meshopt.gltf"] = text(quad_doc(
-        extensionsUsed=["EXT_meshopt_compression"], extensionsRequired=["EXT_meshopt_compression"]))
+    files["extension-required-unsupported.gltf"] = text(quad_doc(
+        extensionsUsed=["KHR_texture_basisu"], extensionsRequired=["KHR_texture_basisu"]))
+    # Compressed geometry whose stream does not decode: the quad's float
+    # positions read as a Draco stream, and as a meshopt vertex stream
+    # (its first byte, 0, is no codec header).
+    d = quad_doc(extensionsUsed=["KHR_draco_mesh_compression"],
+                 extensionsRequired=["KHR_draco_mesh_compression"])
+    d["meshes"][0]["primitives"][0]["extensions"] = {
+        "KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}}
+    files["draco-stream-corrupt.gltf"] = text(d)
+    d = quad_doc(extensionsUsed=["EXT_meshopt_compression"], extensionsRequired=["EXT_meshopt_compression"])
+    d["bufferViews"][0]["extensions"] = {"EXT_meshopt_compression": {
+        "buffer": 0, "byteLength": 12, "byteStride": 12, "count": 4, "mode": "ATTRIBUTES"}}
+    files["meshopt-stream-corrupt.gltf"] = text(d)
+    # A meshopt fallback buffer (no data) under a plain bufferView.
+    d = quad_doc(extensionsUsed=["EXT_meshopt_compression"])
+    d["buffers"].append({"byteLength": 48, "extensions": {"EXT_meshopt_compression": {"fallback": True}}})
+    d["bufferViews"][0]["buffer"] = 1
+    files["meshopt-fallback-plain-view.gltf"] = text(d)
     d = quad_doc()
     d["asset"]["version"] = "1.0"
     files["asset-version-1.gltf"] = text(d)
