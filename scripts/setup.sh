@@ -40,3 +40,15 @@ fi
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
 cmake --build build -j"$(nproc)"
+
+# `import rastray` for the interpreter the module was built for: a .pth
+# file in its user site-packages points at build/python (delete the file
+# to undo; in a virtual environment, `pip install ./python` instead:
+# docs/PYTHON.md).
+if [ -f build/python/interpreter.txt ] && [ -d build/python/rastray ]; then
+  python=$(cat build/python/interpreter.txt)
+  site=$("$python" -c 'import site; print(site.getusersitepackages())')
+  mkdir -p "$site"
+  echo "$PWD/build/python" > "$site/rastray-build.pth"
+  echo "setup: $python imports rastray from $PWD/build/python ($site/rastray-build.pth)" >&2
+fi
