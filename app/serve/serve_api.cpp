@@ -200,10 +200,6 @@ std::string queryDefault(const RenderOptionSpec& spec) {
   return text;
 }
 
-}  // namespace
-
-namespace {
-
 // Which options apply under each setting of what the table's conditions
 // read (--shadows, --wireframe), per renderer and for all of them at once
 // (the views that run every renderer), decided by RenderSettings::applies:
