@@ -17,24 +17,14 @@
 #include "cli/exit_status.h"
 #include "common/error.h"
 #include "common/interrupt.h"
+#include "common/one_line.h"
 
 namespace {
 
 // SPEC §7 promises one line: a message may quote the file's own strings
 // (or a file name) with line breaks or other control characters in them.
 void printErrorLine(const std::string& message) {
-  std::string line;
-  for (const char ch : message) {
-    const unsigned char u = static_cast<unsigned char>(ch);
-    if (u < 0x20 || u == 0x7F) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", u);
-      line += escaped;
-    } else {
-      line += ch;
-    }
-  }
-  std::fprintf(stderr, "%s\n", line.c_str());
+  std::fprintf(stderr, "%s\n", rastray::oneLine(message).c_str());
 }
 
 // An internal check failed (common/error.h): the library aborts after this.

@@ -48,6 +48,7 @@
 #include "common/gltf/loader.h"
 #include "common/image.h"
 #include "common/interrupt.h"
+#include "common/one_line.h"
 #include "compare/color_metrics.h"
 #include "compare/compare_files.h"
 #include "compare/maps.h"
@@ -61,23 +62,6 @@ static_assert(sizeof(glm::vec4) == 4 * sizeof(float), "colour arrays view glm::v
 static_assert(sizeof(uint32_t) == sizeof(int32_t), "IDs are viewed as int32 (kNoId reads as -1)");
 
 // ---- errors -----------------------------------------------------------------
-
-// The message as the command line prints it (cli/main.cpp printErrorLine):
-// one line, control characters escaped.
-std::string oneLine(const std::string& message) {
-  std::string line;
-  for (const char ch : message) {
-    const unsigned char u = static_cast<unsigned char>(ch);
-    if (u < 0x20 || u == 0x7F) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", u);
-      line += escaped;
-    } else {
-      line += ch;
-    }
-  }
-  return line;
-}
 
 PyObject* inputErrorType = nullptr;  // rastray.InputError, a ValueError
 
