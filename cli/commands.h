@@ -19,5 +19,6 @@ CommandRunner addStabilityCommand(CLI::App& app);
 CommandRunner addSweepCommand(CLI::App& app);
 CommandRunner addBenchCommand(CLI::App& app);
 CommandRunner addServeCommand(CLI::App& app);
+CommandRunner addPovrayCommand(CLI::App& app);
 
 }  // namespace rastray

@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   commands.push_back(addSweepCommand(app));
   commands.push_back(addBenchCommand(app));
   commands.push_back(addServeCommand(app));
+  commands.push_back(addPovrayCommand(app));
 #endif
   commands.push_back(addCompareCommand(app));
 

@@ -14,6 +14,7 @@
 
 #include <tbb/global_control.h>
 
+#include "app/engine/render_options.h"
 #include "app/studies/stability.h"
 #include "app/studies/stability_report.h"
 #include "cli/commands.h"
@@ -29,7 +30,8 @@ struct StabilityOptions {
   bool quick = false;
   std::string reportDir, scenesDir, writeScenesDir, caseRegex, jsonFile, csvFile;
   int threads = 0;
-  std::string commandLine;  // for the report
+  std::vector<std::string> shadowBias;  // --shadow-bias C S: for every shadow-map variant
+  std::string commandLine;              // for the report
 };
 
 // A folder for freshly generated scenes, removed when the run ends.
@@ -95,6 +97,13 @@ int runStability(const StabilityOptions& opt) {
                                             : "stability",
                      "selects no case (see scenes/stiff/README.md for their names)");
 
+  std::vector<std::string> shadowMapArgs;
+  if (!opt.shadowBias.empty()) {
+    shadowMapArgs = {"--shadow-bias", opt.shadowBias[0], opt.shadowBias[1]};
+    // Its values checked by the option's own row before any case runs.
+    renderSettingsFrom({"--renderer", "raster", "--shadow-bias", opt.shadowBias[0], opt.shadowBias[1]});
+  }
+
   std::unique_ptr<TempDir> temp;
   std::string sceneDir = opt.scenesDir;
   if (sceneDir.empty()) {
@@ -131,6 +140,7 @@ int runStability(const StabilityOptions& opt) {
     ctx.reportDir = opt.reportDir;
     ctx.quick = opt.quick;
     ctx.threads = opt.threads;
+    ctx.shadowMapArgs = shadowMapArgs;
     if (terminal)
       ctx.progress = [&, i](const std::string& line) {
         std::fprintf(stderr, "\r\033[K[%zu/%zu] %s: %s", i + 1, selected.size(), c.name.c_str(),
@@ -188,13 +198,18 @@ CommandRunner addStabilityCommand(CLI::App& app) {
                   "Write every case's scene and README.md into this folder (e.g. scenes/stiff), then stop");
   cmd->add_option("--case", opt->caseRegex, "Run only the cases whose name matches this regular expression");
   cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+  cmd->add_option("--shadow-bias", opt->shadowBias,
+                  "Constant and slope-scaled bias for every variant that draws shadow maps (as render "
+                  "--shadow-bias; default: the render default), to sweep them over the cases")
+      ->expected(2);
   cmd->add_option("--json", opt->jsonFile, "Save the rows as JSON to this file");
   cmd->add_option("--csv", opt->csvFile, "Save the rows as CSV to this file");
   cmd->get_option("--write-scenes")
       ->excludes("--scenes")
       ->excludes("--report")
       ->excludes("--quick")
-      ->excludes("--case");
+      ->excludes("--case")
+      ->excludes("--shadow-bias");
   return [opt, cmd]() -> int {
     if (!cmd->parsed()) return -1;
     opt->commandLine = "rastray stability";

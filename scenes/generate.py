@@ -479,6 +479,26 @@ def transparent_layers():
     return g.finish()
 
 
+def floor_box_sphere():
+    """A floor, a box and a flat-shaded sphere (no NORMAL: face normals) under
+    one directional light, opaque and diffuse: shadow masks against an
+    independent ray tracer (`rastray povray`, docs/SHADOWS.md)."""
+    g = Gltf()
+    floor = Geometry()
+    floor.face((0, 0, 0), (0, 1, 0), (1, 0, 0), 2.5, 2.5)
+    g.mesh_node("Floor", [(floor, g.material("Floor", (0.8, 0.8, 0.8, 1.0)))])
+    g.mesh_node("Box", [(box((0.7, 0.7, 0.7)), g.material("Box", (0.7, 0.5, 0.3, 1.0)))],
+                translation=(-0.6, 0.35, -0.2), rotation=axis_angle((0, 1, 0), math.radians(30)))
+    sphere = uv_sphere(0.45, 16, 10)
+    sphere.normals = []
+    g.mesh_node("FlatSphere", [(sphere, g.material("Sphere", (0.3, 0.5, 0.7, 1.0)))],
+                translation=(0.7, 0.45, 0.3))
+    g.light("Sun", {"type": "directional", "color": [1.0, 1.0, 1.0], "intensity": 3.0},
+            rotation=look_rotation((0.5, -1.0, -0.35)))
+    g.perspective_camera("Camera", (0.3, 2.4, 3.6), (0.0, 0.2, 0.0), yfov=0.75, znear=0.1, zfar=100.0)
+    return g.finish()
+
+
 CHECKER_SIZE, CHECKER_SQUARE = 256, 32   # 8×8 squares per texture tile
 PLANE_HALF, PLANE_CELLS, PLANE_UV = 64.0, 16, 8.0   # 128×128 units, uv 0..8 → 64×64 squares
 
@@ -581,6 +601,7 @@ SCENES = [
     ("transparent-layers.gltf", transparent_layers),
     ("textured-plane.gltf", textured_plane),
     ("vertex-colors.gltf", vertex_colors),
+    ("floor-box-sphere.gltf", floor_box_sphere),
 ]
 
 
@@ -785,7 +806,7 @@ def check_file(path):
                     for i in t:
                         require(abs(dot(normals[i], normals[i]) - 1) < 1e-5, where, "normal not unit")
                         require(dot(fn, normals[i]) > 0, where, "triangle %s wound against its normals" % (t,))
-            if mesh["name"] in ("MirrorBlock", "GlassSphere"):
+            if mesh["name"] in ("MirrorBlock", "GlassSphere", "Box", "FlatSphere"):
                 edge_closed(pos, tris, where)
             counts["triangles"] += len(tris)
             counts["vertices"] += len(pos)

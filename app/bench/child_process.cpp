@@ -80,6 +80,11 @@ ChildResult runChild(const std::string& program, const std::vector<std::string>&
     ::dup2(outFd, 1);
     ::dup2(errFd, 2);
     if (limits.addressSpaceBytes) ::setrlimit(RLIMIT_AS, &as);
+    if (!limits.workingDirectory.empty() && ::chdir(limits.workingDirectory.c_str()) != 0) {
+      static const char noDir[] = "cannot enter the working directory\n";
+      (void)!::write(2, noDir, sizeof noDir - 1);
+      _exit(127);
+    }
     ::execv(argv[0], argv.data());
     static const char message[] = "cannot execute the program\n";
     (void)!::write(2, message, sizeof message - 1);

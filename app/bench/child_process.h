@@ -17,6 +17,9 @@ struct ChildLimits {
   // RLIMIT_AS for the child, so a cell too big for the machine fails with
   // std::bad_alloc in the child instead of waking the OOM killer; 0: none.
   uint64_t addressSpaceBytes = 0;
+  // The child's working directory; empty: this process's. (POV-Ray writes
+  // only where its configuration permits, "." among them.)
+  std::string workingDirectory;
 };
 
 struct ChildResult {

@@ -9,6 +9,7 @@ std::vector<Case> allCases() {
   appendGeometryCases(cases);
   appendOpticsCases(cases);
   appendLayerCases(cases);
+  appendLightCases(cases);
   return cases;
 }
 

@@ -27,6 +27,11 @@ struct CaseContext {
   std::string reportDir;  // where to write images for the report; empty: write none
   bool quick = false;     // --quick: the case's cheapest representative variants only
   int threads = 0;        // 0: all cores
+  // Render options added to every variant that draws shadow maps (the
+  // rasterizer, hybrid with --shadows map), e.g. {"--shadow-bias", "1",
+  // "0.25"} (stability --shadow-bias): to sweep the maps' settings over the
+  // cases. Empty: the defaults.
+  std::vector<std::string> shadowMapArgs;
   // One short line per finished render (may be empty).
   std::function<void(const std::string&)> progress;
 };
@@ -60,7 +65,7 @@ struct Row {
 
 struct Case {
   std::string name;        // file stem under scenes/stiff/ and row name
-  std::string group;       // "depth", "far", "slivers", "grazing", "glass", "layers", "clip", "scale"
+  std::string group;       // "depth", "far", "slivers", "grazing", "glass", "layers", "clip", "scale", "lights"
   std::string parameters;  // the generator's parameters in words: "near/far 1e-5, gap 1e-4 of depth"
   bool quick = false;      // part of the --quick subset (together under a minute on 2 cores)
   std::function<GltfScene()> build;  // the scene; written to <sceneDir>/<name>.gltf
@@ -77,5 +82,6 @@ void appendFarCases(std::vector<Case>& cases);      // offsets 1e3..1e7, baked a
 void appendGeometryCases(std::vector<Case>& cases); // sub-pixel, slivers, pixel-aligned, grazing, scale
 void appendOpticsCases(std::vector<Case>& cases);   // TIR band, nested dielectrics, trapped rays
 void appendLayerCases(std::vector<Case>& cases);    // 1,000 layers, extreme alphas, near plane / w = 0, degenerate
+void appendLightCases(std::vector<Case>& cases);    // point (cube map) and spot lights over the shadow maps
 
 }  // namespace rastray::stability

@@ -19,6 +19,11 @@ Rendered renderVariant(const CaseContext& ctx, const std::string& scenePath,
                        const std::vector<std::string>& args, bool deep, const std::string& label) {
   Rendered r;
   r.settings = renderSettingsFrom(args);
+  if (!ctx.shadowMapArgs.empty() && r.settings.shadowModeFor(r.settings.renderer) == ShadowMode::Map) {
+    std::vector<std::string> withMapArgs = args;
+    withMapArgs.insert(withMapArgs.end(), ctx.shadowMapArgs.begin(), ctx.shadowMapArgs.end());
+    r.settings = renderSettingsFrom(withMapArgs);
+  }
   r.settings.keepSamples = deep;
   r.scene = loadSceneForRender(scenePath, r.settings);
   r.run = renderScene(r.scene, r.settings);
@@ -119,7 +124,7 @@ ShadowCheck checkShadows(const Rendered& r, double tolerance, double minCosine,
   const Scene& scene = r.scene;
   if (scene.lights.empty()) return out;
   for (const Light& light : scene.lights)
-    if (light.type == LightType::Spot || (light.type == LightType::Point && light.range > 0.0f)) return out;
+    if (light.type != LightType::Directional && light.range > 0.0f) return out;
   if (!r.run.output.hasSamples) throw std::logic_error("checkShadows: the render needs its samples");
   out.acne = out.leaks = 0;
   out.shadowed.assign(scene.lights.size(), 0);
@@ -165,7 +170,7 @@ ShadowCheck checkShadows(const Rendered& r, double tolerance, double minCosine,
       const Light& light = scene.lights[l];
       const auto towards = [&](const glm::dvec3& q, double* distance) {
         *distance = INFINITY;
-        if (light.type != LightType::Point) return glm::dvec3(-light.direction);
+        if (light.type == LightType::Directional) return glm::dvec3(-light.direction);
         const glm::dvec3 v = light.position - q;
         *distance = glm::length(v);
         return v / *distance;
@@ -225,11 +230,20 @@ ShadowCheck checkShadows(const Rendered& r, double tolerance, double minCosine,
           const Light& light = scene.lights[l];
           glm::dvec3 toLight = -light.direction;
           double distance = INFINITY, irradiance = light.intensity;
-          if (light.type == LightType::Point) {
+          if (light.type != LightType::Directional) {
             toLight = light.position - p;
             distance = glm::length(toLight);
             toLight /= distance;
             irradiance = light.intensity / (distance * distance);
+          }
+          if (light.type == LightType::Spot) {
+            // The cone's smooth falloff, as common/shading.cpp: outside the
+            // outer cone no share under any visibility.
+            const double cosOuter = std::cos(light.outerConeAngle), cosInner = std::cos(light.innerConeAngle);
+            const double cd = glm::dot(light.direction, -toLight);
+            const double t = std::clamp((cd - cosOuter) / std::max(1e-6, cosInner - cosOuter), 0.0, 1.0);
+            if (t == 0.0) continue;
+            irradiance *= t * t;
           }
           const double cosine = glm::dot(n, toLight);
           if (cosine <= 0.0) continue;  // faces away: no share under any visibility

@@ -37,7 +37,8 @@ struct Rendered {
 };
 
 // Loads `scenePath` for the options `args` (render syntax, "--renderer X"
-// included) and renders it; deep = true keeps every sample and layer
+// included; plus ctx.shadowMapArgs when the variant draws shadow maps) and
+// renders it; deep = true keeps every sample and layer
 // (run.output.samples), which the visibility comparisons need. Reports
 // "<label>: <seconds> s" through ctx.progress when it is set.
 Rendered renderVariant(const CaseContext& ctx, const std::string& scenePath,
@@ -95,8 +96,10 @@ CrossvalResult crossvalidateVariant(const CaseContext& ctx, const std::string& s
 // exact, e.g. an axis-aligned plane under a grazing light), or a shadow
 // ray passing within `tolerance` (world units) of an occluder's edge, or
 // a triangle within 1e-6 along the ray (a coplanar neighbour).
-// Needs directional or point lights (without range); otherwise (spot
-// lights, ranged lights, no light) acne and leaks are -1 (not measured).
+// Needs directional, point or spot lights (point and spot without range;
+// a spot's cone falloff scales its share, and outside its outer cone it
+// has none); otherwise (ranged lights, no light) acne and leaks are -1
+// (not measured).
 // With `texelWidth` (a shadow-map render: the two sides of light l's map
 // texel near a point as world vectors, raster/shadow_map.h
 // shadowMapTexel), a disagreeing sample whose reference visibility changes

@@ -57,10 +57,11 @@ struct GltfCamera {
 };
 
 struct GltfLight {
-  std::string type = "directional";      // directional, point
-  glm::dvec3 position{0.0};              // point
-  glm::dvec3 direction{0.0, -1.0, 0.0};  // directional: the way light travels
+  std::string type = "directional";      // directional, point, spot
+  glm::dvec3 position{0.0};              // point, spot
+  glm::dvec3 direction{0.0, -1.0, 0.0};  // directional, spot: the way light travels (not parallel to +-y)
   float intensity = 3.0f;
+  float innerConeAngle = 0.0f, outerConeAngle = 0.7853981634f;  // spot, radians
 };
 
 struct GltfScene {

@@ -17,15 +17,19 @@
 
 #include "app/studies/stability.h"
 #include "app/studies/stability_measure.h"
+#include "tests/test_files.h"
 
 namespace rastray::stability {
 namespace {
+
+using Args = std::vector<std::string>;
 
 Case findCase(const std::string& name) {
   std::vector<Case> cases;
   appendDepthCases(cases);
   appendFarCases(cases);
   appendGeometryCases(cases);
+  appendLightCases(cases);
   for (const Case& c : cases)
     if (c.name == name) return c;
   ADD_FAILURE() << "no case " << name;
@@ -143,6 +147,46 @@ TEST(StabilityShadowMaps, GrazingLightKeepsItsShadow) {
   EXPECT_EQ(raster.acne, 0);
   EXPECT_TRUE(raster.pass) << raster.property;
   EXPECT_EQ(rowOf(rows, "hybrid vs raytrace").leaks, 0);  // traced shadows: the same reference agrees
+}
+
+// A point light's cube map (the floor across five faces, the contact
+// shadows of box and sphere 0.01 above it) and a spot light's perspective
+// map: the receiver plane's perspective forms under the same bounds, and
+// the shadow rays exact against the same reference.
+TEST(StabilityShadowMaps, PointLightCubeMapKeepsTheBiasBounds) {
+  const auto rows = runCase("light-point-cube");
+  expectShadowMapBounds(rowOf(rows, "raster"));
+  EXPECT_EQ(rowOf(rows, "raytrace").acne, 0);
+  EXPECT_EQ(rowOf(rows, "raytrace").leaks, 0);
+}
+
+TEST(StabilityShadowMaps, SpotLightMapKeepsTheBiasBounds) {
+  const auto rows = runCase("light-spot");
+  expectShadowMapBounds(rowOf(rows, "raster"));
+  EXPECT_EQ(rowOf(rows, "raytrace").acne, 0);
+  EXPECT_EQ(rowOf(rows, "raytrace").leaks, 0);
+}
+
+// stability --shadow-bias: the bias reaches the variants that draw maps
+// (raster, hybrid with --shadows map) and no other (where the option would
+// be refused as not applying).
+TEST(StabilityShadowMaps, ShadowBiasOptionReachesEveryShadowMapVariantOnly) {
+  CaseContext ctx;
+  ctx.shadowMapArgs = {"--shadow-bias", "2", "0.25"};
+  const std::string scene = test::scenePath("cornell-box.gltf");
+  const Args size = {"--size", "16", "12"};
+  auto with = [&](Args args) {
+    args.insert(args.end(), size.begin(), size.end());
+    return renderVariant(ctx, scene, args, false).settings;
+  };
+  const RenderSettings raster = with({"--renderer", "raster"});
+  EXPECT_EQ(raster.raster.shadowBiasConstant, 2.0f);
+  EXPECT_EQ(raster.raster.shadowBiasSlope, 0.25f);
+  const RenderSettings hybridMaps = with({"--renderer", "hybrid", "--shadows", "map"});
+  EXPECT_EQ(hybridMaps.raster.shadowBiasSlope, 0.25f);
+  EXPECT_FALSE(with({"--renderer", "raytrace"}).isGiven("--shadow-bias"));
+  EXPECT_FALSE(with({"--renderer", "hybrid"}).isGiven("--shadow-bias"));
+  EXPECT_FALSE(with({"--renderer", "raster", "--shadows", "none"}).isGiven("--shadow-bias"));
 }
 
 TEST(StabilityShadowMaps, ScaledScenesKeepTheBiasBounds) {
