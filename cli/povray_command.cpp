@@ -51,6 +51,16 @@ int runPovray(PovrayOptions& opt) {
   const std::string& masks = opt.masksPath;
   if (!masks.empty() && (masks.size() < 4 || masks.compare(masks.size() - 4, 4, ".png") != 0))
     throw InputError("command line", "--masks", "'" + opt.masksPath + "' must end in .png");
+  if (!opt.exportOnly && opt.settings.spp != 1)
+    throw InputError(
+        "command line", "--spp",
+        "the POV-Ray check compares one sample per pixel (POV-Ray traces the pixel centre): give "
+        "--spp 1");
+  installInterruptHandlers();
+  Scene scene = loadSceneForRender(opt.scenePath, opt.settings);
+  if (!opt.exportOnly && scene.lights.empty())
+    throw InputError(scene.path, "lights",
+                     "the scene has no light (lit by the eye light): no shadows to compare");
   std::string povray;
   if (!opt.exportOnly) {
     povray = findPovray();
@@ -59,8 +69,6 @@ int runPovray(PovrayOptions& opt) {
                        "not found on PATH: install POV-Ray 3.7 (Debian package povray), or write the scene "
                        "alone with --export-only --pov FILE");
   }
-  installInterruptHandlers();
-  Scene scene = loadSceneForRender(opt.scenePath, opt.settings);
 
   if (opt.exportOnly) {
     makeOpaqueDiffuse(scene);
@@ -124,6 +132,7 @@ CommandRunner addPovrayCommand(CLI::App& app) {
                   "Exit 1 when more than this percentage of the lit pixels differ")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", opt->json, "Print the counts as JSON");
+  cmd->get_option("--export-only")->excludes("--masks")->excludes("--max-disagreement")->excludes("--json");
   opt->renderCli.add(*cmd, /*withRenderer=*/true);
   return [opt, cmd]() -> int { return cmd->parsed() ? runPovray(*opt) : -1; };
 }
