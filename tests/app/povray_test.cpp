@@ -193,9 +193,9 @@ TEST(PovrayCheck, FloorBoxAndFlatSphereUnderADirectionalLightAgreeWithPovray) {
 // 3.7 starts a smooth triangle's shadow ray on the flat triangle, as
 // rastray does with --terminator none: its glass sphere (opaque here) shows
 // the faceted terminator, and the two masks agree on all but 0.05 % of the
-// lit pixels (measured: 13 of 91,335, light reaching one render only at
-// the sphere's rim, where float and double normals decide n·l > 0
-// differently). With the default terminator rastray lights those facets
+// lit pixels (measured: 13 of 91,335, light reaching one render only on
+// the sphere's outline, where the camera ray grazes the mesh and POV-Ray
+// leaves pixels black that rastray lights). With the default terminator rastray lights those facets
 // (100 pixels): every pixel it shadows is shadowed in POV-Ray too, and
 // every pixel it lights where POV-Ray shadows lies on the sphere.
 TEST(PovrayCheck, CornellBoxRayCastMasksAgreeWithPovrayOnAllBut005PercentOfTheLitPixels) {
