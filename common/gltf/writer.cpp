@@ -178,7 +178,8 @@ nlohmann::json buildDocument(const GltfScene& scene, std::vector<unsigned char>&
       const GltfLight& l = lights[i];
       lightsJson.push_back({{"type", l.type}, {"intensity", l.intensity}});
       if (l.type == "spot")
-        lightsJson.back()["spot"] = {{"innerConeAngle", l.innerConeAngle}, {"outerConeAngle", l.outerConeAngle}};
+        lightsJson.back()["spot"] = {{"innerConeAngle", l.innerConeAngle},
+                                     {"outerConeAngle", l.outerConeAngle}};
       nodes.push_back({{"extensions", {{"KHR_lights_punctual", {{"light", i}}}}},
                        {"matrix", lookAtNodeMatrix(l.position, l.direction, glm::dvec3(0, 1, 0))}});
       sceneNodes.push_back(nodes.size() - 1);
