@@ -32,18 +32,6 @@ struct PovrayOptions {
   RenderOptionsCli renderCli;
 };
 
-nlohmann::json agreementJson(const ShadowMaskAgreement& a) {
-  return {{"pixels", a.pixels},
-          {"lit_reference", a.litReference},
-          {"shadowed_reference", a.shadowedReference},
-          {"shadowed_ours", a.shadowedOurs},
-          {"ours_shadowed_reference_lit", a.oursShadowedRefLit},
-          {"ours_lit_reference_shadowed", a.oursLitRefShadowed},
-          {"lit_in_one_only", a.litInOneOnly},
-          {"disagreeing", a.disagreeing()},
-          {"disagreeing_percent", 100.0 * a.disagreeingFraction()}};
-}
-
 int runPovray(PovrayOptions& opt) {
   opt.settings = opt.renderCli.settings(/*allRenderers=*/false);
   if (opt.exportOnly && opt.povPath.empty())
@@ -87,14 +75,7 @@ int runPovray(PovrayOptions& opt) {
   const ShadowMaskAgreement& a = check.agreement;
   const double percent = 100.0 * a.disagreeingFraction();
   if (opt.json) {
-    std::cout << nlohmann::json{{"scene", opt.scenePath},
-                                {"renderer", toString(opt.settings.renderer)},
-                                {"width", check.camera.width},
-                                {"height", check.camera.height},
-                                {"povray_seconds", check.povraySeconds},
-                                {"agreement", agreementJson(a)}}
-                     .dump(2)
-              << "\n";
+    std::cout << povrayCheckJson(opt.scenePath, opt.settings, check).dump(2) << "\n";
   } else {
     std::printf(
         "%s: %s %dx%d, shadow masks against POV-Ray (every material opaque and diffuse): %zu of %zu lit "
@@ -131,7 +112,7 @@ CommandRunner addPovrayCommand(CLI::App& app) {
   cmd->add_option("--max-disagreement", opt->maxDisagreement,
                   "Exit 1 when more than this percentage of the lit pixels differ")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--json", opt->json, "Print the counts as JSON");
+  cmd->add_flag("--json", opt->json, "Print the counts as JSON (schema rastray.povray)");
   cmd->get_option("--export-only")->excludes("--masks")->excludes("--max-disagreement")->excludes("--json");
   opt->renderCli.add(*cmd, /*withRenderer=*/true);
   return [opt, cmd]() -> int { return cmd->parsed() ? runPovray(*opt) : -1; };

@@ -125,7 +125,7 @@ std::string povSceneText(const Scene& scene, const Camera& camera) {
       << "// Written by `rastray povray --pov`. Render it as rastray's 1-spp frame:\n"
       << "//   povray "
       << "+I<this file> +O<out>.exr +FE +W" << camera.width << " +H" << camera.height
-      << " -A -D -P +Q4   (shadows; +Q3: without)\n"
+      << " -A -D -P +WT1 +Q4   (shadows; +Q3: without)\n"
       << "// Positions are relative to rastray's render origin " << vec(scene.origin) << ".\n"
       << "#version 3.7;\n"
       << "global_settings { assumed_gamma 1.0 ambient_light rgb 0 max_trace_level 1 }\n"
@@ -139,9 +139,17 @@ std::string povSceneText(const Scene& scene, const Camera& camera) {
 
 std::vector<std::string> povrayArguments(const std::string& input, const std::string& output, int width,
                                          int height, bool shadows) {
-  return {
-      "+I" + input, "+O" + output, "+FE", "+W" + std::to_string(width), "+H" + std::to_string(height), "-A",
-      "-D",         "-P",          "-V",  shadows ? "+Q4" : "+Q3"};
+  return {"+I" + input,
+          "+O" + output,
+          "+FE",
+          "+W" + std::to_string(width),
+          "+H" + std::to_string(height),
+          "-A",
+          "-D",
+          "-P",
+          "-V",
+          "+WT1",
+          shadows ? "+Q4" : "+Q3"};
 }
 
 }  // namespace rastray

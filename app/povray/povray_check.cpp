@@ -127,4 +127,26 @@ PovrayCheck runPovrayCheck(Scene scene, const RenderSettings& settings, const st
   return check;
 }
 
+nlohmann::json povrayCheckJson(const std::string& scenePath, const RenderSettings& settings,
+                               const PovrayCheck& check) {
+  const ShadowMaskAgreement& a = check.agreement;
+  return {{"schema", "rastray.povray"},
+          {"version", 1},
+          {"scene", scenePath},
+          {"renderer", toString(settings.renderer)},
+          {"width", check.camera.width},
+          {"height", check.camera.height},
+          {"povray_seconds", check.povraySeconds},
+          {"agreement",
+           {{"pixels", a.pixels},
+            {"lit_reference", a.litReference},
+            {"shadowed_reference", a.shadowedReference},
+            {"shadowed_ours", a.shadowedOurs},
+            {"ours_shadowed_reference_lit", a.oursShadowedRefLit},
+            {"ours_lit_reference_shadowed", a.oursLitRefShadowed},
+            {"lit_in_one_only", a.litInOneOnly},
+            {"disagreeing", a.disagreeing()},
+            {"disagreeing_percent", 100.0 * a.disagreeingFraction()}}}};
+}
+
 }  // namespace rastray

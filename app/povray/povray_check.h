@@ -8,6 +8,8 @@
 
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "app/engine/render_options.h"
 #include "app/povray/shadow_masks.h"
 #include "common/camera.h"
@@ -41,5 +43,10 @@ RenderSettings withoutShadows(const RenderSettings& settings);
 // Throws InputError naming POV-Ray when it fails, with its message.
 PovrayCheck runPovrayCheck(Scene scene, const RenderSettings& settings, const std::string& povray,
                            const ShadowMaskOptions& options = {});
+
+// The check as JSON (schema rastray.povray, version 1): scene, renderer,
+// size, POV-Ray's seconds and the counts of ShadowMaskAgreement.
+nlohmann::json povrayCheckJson(const std::string& scenePath, const RenderSettings& settings,
+                               const PovrayCheck& check);
 
 }  // namespace rastray
