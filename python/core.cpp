@@ -190,9 +190,12 @@ struct PyScene {
 };
 
 // The scene prepared for `settings` (selectLights, render origin), as
-// loadSceneForRender gives the command line.
+// loadSceneForRender gives the command line. Another pose (time=,
+// animation=) than the one loaded loads the file again at that pose.
 std::shared_ptr<const Scene> prepared(const PyScene& s, const RenderSettings& settings) {
-  auto scene = std::make_shared<Scene>(*s.scene);
+  auto scene = settings.pose == s.scene->pose
+                   ? std::make_shared<Scene>(*s.scene)
+                   : std::make_shared<Scene>(loadScene(s.scene->path, settings.memory, settings.pose));
   prepareSceneForRender(*scene, settings);
   return scene;
 }

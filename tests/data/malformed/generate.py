@@ -131,6 +131,37 @@ def cube_doc(index_values):
     return b.gltf([mesh], [{"mesh": 0}], scenes=[{"nodes": [0]}], scene=0)
 
 
+def animated_quad(times, values, interpolation="LINEAR", path="translation", type_="VEC3"):
+    """quad_doc's quad with one animation channel on node 0. Accessors:
+    0 POSITION, 1 NORMAL, 2 indices, 3 input times, 4 output values."""
+    b = Builder()
+    pos = b.positions(QUAD)
+    nrm = b.vec3([(0, 0, 1)] * 4)
+    idx = b.indices([0, 1, 2, 0, 2, 3])
+    times_accessor = b.accessor(times, FLOAT, "SCALAR")
+    values_accessor = b.accessor(values, FLOAT, type_)
+    mesh = {"primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": idx}]}
+    animation = {"samplers": [{"input": times_accessor, "output": values_accessor,
+                               "interpolation": interpolation}],
+                 "channels": [{"sampler": 0, "target": {"node": 0, "path": path}}]}
+    return b.gltf([mesh], [{"mesh": 0}], scenes=[{"nodes": [0]}], scene=0, animations=[animation])
+
+
+def skinned_quad(joints):
+    """The quad skinned to node 1, with the skin's joint list `joints`.
+    Accessors: 0 POSITION, 1 indices, 2 JOINTS_0 (vertex 3 names joint 1),
+    3 WEIGHTS_0."""
+    b = Builder()
+    pos = b.positions(QUAD)
+    idx = b.indices([0, 1, 2, 0, 2, 3])
+    jnt = b.accessor([0, 0, 0, 0] * 3 + [1, 0, 0, 0], USHORT, "VEC4")
+    wgt = b.accessor([1, 0, 0, 0] * 4, FLOAT, "VEC4")
+    mesh = {"primitives": [{"attributes": {"POSITION": pos, "JOINTS_0": jnt, "WEIGHTS_0": wgt},
+                            "indices": idx}]}
+    return b.gltf([mesh], [{"mesh": 0, "skin": 0}, {}, {}], scenes=[{"nodes": [0, 1, 2]}], scene=0,
+                  skins=[{"joints": joints}])
+
+
 def text(doc):
     return json.dumps(doc, indent=1) + "\n"
 
@@ -303,6 +334,25 @@ def malformed():
     files["sparse-index-out-of-range.gltf"] = text(
         b.gltf([{"primitives": [{"attributes": {"POSITION": pos}}]}], [{"mesh": 0}],
                scenes=[{"nodes": [0]}]))
+
+    # Animations, skins, morph targets.
+    files["animation-times-not-increasing.gltf"] = text(
+        animated_quad([0, 1, 1], [0, 0, 0, 1, 0, 0, 2, 0, 0]))
+    files["animation-output-too-short.gltf"] = text(animated_quad([0, 1, 2], [0, 0, 0, 1, 0, 0]))
+    files["animation-keyframe-nan.gltf"] = text(animated_quad([0, 1], [0, 0, 0, float("nan"), 0, 0]))
+    files["animation-interpolation-bad.gltf"] = text(
+        animated_quad([0, 1], [0, 0, 0, 1, 0, 0], interpolation="SMOOTH"))
+    d = animated_quad([0, 1], [0, 0, 0, 1, 0, 0])
+    d["animations"][0]["channels"][0]["target"]["node"] = 5
+    files["animation-channel-node-missing.gltf"] = text(d)
+    files["animation-rotation-zero-key.gltf"] = text(
+        animated_quad([0, 1], [0, 0, 0, 1, 0, 0, 0, 0], path="rotation", type_="VEC4"))
+    files["skin-no-joints.gltf"] = text(skinned_quad([]))
+    files["skin-joint-out-of-range.gltf"] = text(skinned_quad([1]))
+    d = quad_doc()
+    d["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": 1}]
+    d["nodes"][0]["weights"] = [0.5, 0.5]
+    files["morph-weights-count.gltf"] = text(d)
 
     # Node graph and scenes.
     d = quad_doc()
