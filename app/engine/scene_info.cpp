@@ -181,7 +181,9 @@ nlohmann::json sceneInfoJson(const Scene& scene, const CameraOptions& options) {
                     {"degenerate", in.degenerateCount},
                     {"mirrored", in.mirrored},
                     {"normals", in.normals == NormalSource::Authored ? "authored" : "flat"},
-                    {"vertexColors", in.hasColors}});
+                    {"vertexColors", in.hasColors},
+                    {"skinned", in.skinned},
+                    {"morphed", in.morphed}});
   }
   j["instanceList"] = inst;
   return j;

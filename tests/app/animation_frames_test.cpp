@@ -8,8 +8,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <thread>
+
+#include <httplib.h>
 
 #include "app/engine/render_setup.h"
+#include "app/serve/serve_server.h"
 #include "run_command.h"
 #include "tests/test_files.h"
 
@@ -23,8 +27,9 @@ const std::string kSkin = "/usr/share/assimp/models/glTF2/simple_skin/simple_ski
 const std::string kMorph =
     "/usr/share/assimp/models/glTF2/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf";
 
-#define REQUIRE_FILE(path) \
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not installed (apt-get install assimp-testmodels)"
+#define REQUIRE_FILE(path)            \
+  if (!std::filesystem::exists(path)) \
+  GTEST_SKIP() << path << " is not installed (apt-get install assimp-testmodels)"
 
 // A fixed camera on the rest pose's bounds, so that only the pose moves.
 std::vector<std::string> fixedCamera(const std::string& path) {
@@ -32,8 +37,14 @@ std::vector<std::string> fixedCamera(const std::string& path) {
   const glm::dvec3 c = (rest.bounds.lo + rest.bounds.hi) * 0.5;
   const double size = glm::length(rest.bounds.hi - rest.bounds.lo);
   const auto text = [](double v) { return std::to_string(v); };
-  return {"--eye", text(c.x + 0.8 * size), text(c.y + 0.5 * size), text(c.z + 2.0 * size),
-          "--target", text(c.x), text(c.y), text(c.z)};
+  return {"--eye",
+          text(c.x + 0.8 * size),
+          text(c.y + 0.5 * size),
+          text(c.z + 2.0 * size),
+          "--target",
+          text(c.x),
+          text(c.y),
+          text(c.z)};
 }
 
 FlatImage renderAt(const std::string& path, const std::string& time) {
@@ -70,14 +81,15 @@ TEST(AnimationFrames, CrossvalIsCleanAtThreeTimes) {
   REQUIRE_FILE(kSkin);
   REQUIRE_FILE(kMorph);
   for (const char* time : {"0.4", "1.3", "3.1"}) {
-    const auto r = runRastray({"crossval", kSkin, kMorph, "--size", "96", "72", "--spp", "4", "--time", time,
-                               "--json"});
+    const auto r =
+        runRastray({"crossval", kSkin, kMorph, "--size", "96", "72", "--spp", "4", "--time", time, "--json"});
     ASSERT_EQ(r.status, 0) << r.out << r.err;
     const json j = json::parse(r.out);
     ASSERT_EQ(j["scenes"].size(), 2u);
     for (const json& s : j["scenes"]) {
       for (const char* pair : {"rasterVsRaytrace", "hybridVsRaytrace"})
-        EXPECT_EQ(s[pair]["visibility"]["mismatches"]["genuine"], 0) << s["scene"] << " " << pair << " t=" << time;
+        EXPECT_EQ(s[pair]["visibility"]["mismatches"]["genuine"], 0)
+            << s["scene"] << " " << pair << " t=" << time;
       EXPECT_EQ(s["hybridVsRaytrace"]["color"]["maxWhereHitsAgree"].get<double>(), 0.0)
           << s["scene"] << " t=" << time;
     }
@@ -105,11 +117,42 @@ TEST(AnimationFrames, InfoListsAnimationsWithDurations) {
 TEST(AnimationFrames, SweepVariesTime) {
   REQUIRE_FILE(kMorph);
   const std::string report = test::scratchPath("sweep");
-  const auto r = runRastray({"sweep", kMorph, "--vary", "time=0,1.5,3", "--renderer", "raster", "--size", "32",
-                             "24", "--repeat", "1", "--report", report});
+  const auto r = runRastray({"sweep", kMorph, "--vary", "time=0,1.5,3", "--renderer", "raster", "--size",
+                             "32", "24", "--repeat", "1", "--report", report});
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const json j = json::parse(test::slurp(report + "/sweep.json"));
   ASSERT_EQ(j["cells"].size(), 3u) << j.dump();
+}
+
+// serve: /api/scene gives the explorer the animations and the slider's
+// range; a frame at another time is another picture.
+TEST(AnimationFrames, ServeTellsTheDurationAndRendersAnyTime) {
+  REQUIRE_FILE(kMorph);
+  serve::ServeOptions options;
+  options.scenes = {kMorph};
+  options.port = 0;
+  serve::ExplorerServer server(options);
+  const int port = server.bind();
+  std::thread thread([&] { server.run(); });
+  httplib::Client client("127.0.0.1", port);
+  client.set_read_timeout(120, 0);
+  const std::string scene = "scene=" + httplib::detail::encode_query_param(kMorph);
+  const auto info = client.Get(("/api/scene?" + scene).c_str());
+  const auto at0 = client.Get(("/api/image?" + scene + "&size=48,36&time=0").c_str());
+  const auto at2 = client.Get(("/api/image?" + scene + "&size=48,36&time=2").c_str());
+  const auto page = client.Get("/explorer.js");
+  server.stop();
+  thread.join();
+  ASSERT_TRUE(info && at0 && at2 && page);
+  ASSERT_EQ(info->status, 200) << info->body;
+  const json j = json::parse(info->body);
+  ASSERT_EQ(j["animations"].size(), 1u);
+  EXPECT_EQ(j["animations"][0]["name"], "Square");
+  EXPECT_NEAR(j["duration"].get<double>(), 4.2, 1e-5);
+  ASSERT_EQ(at0->status, 200) << at0->body;
+  ASSERT_EQ(at2->status, 200) << at2->body;
+  EXPECT_NE(at0->body, at2->body);
+  EXPECT_NE(page->body.find("writeTimeSlider"), std::string::npos);
 }
 
 // Bad animation data through the binary: exit 2, one line naming the
@@ -127,11 +170,14 @@ TEST(AnimationFrames, BadAnimationDataIsExitTwoWithOneLine) {
   const std::string out = folder + "/never-written.png";
   const auto r = runRastray({"render", path, "--time", "1", "-o", out});
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.err, path + ": animation 0 sampler 0: \"interpolation\" \"BEZIER\" is not STEP, LINEAR or CUBICSPLINE\n");
+  EXPECT_EQ(
+      r.err,
+      path + ": animation 0 sampler 0: \"interpolation\" \"BEZIER\" is not STEP, LINEAR or CUBICSPLINE\n");
   EXPECT_FALSE(std::filesystem::exists(out));
   const auto index = runRastray({"render", kMorph, "--time", "1", "--animation", "2", "-o", out});
   EXPECT_EQ(index.status, 2);
-  EXPECT_EQ(index.err, "command line: --animation: animation 2 does not exist: " + kMorph + " has 1 animation\n");
+  EXPECT_EQ(index.err,
+            "command line: --animation: animation 2 does not exist: " + kMorph + " has 1 animation\n");
 }
 
 }  // namespace

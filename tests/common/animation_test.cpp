@@ -310,6 +310,24 @@ TEST(Animation, SummariesListNamesChannelsAndKeyRanges) {
   for (const IgnoredFeature& f : s.ignored) EXPECT_EQ(f.feature.find("animation"), std::string::npos);
 }
 
+// tests/data/malformed/valid/animated.gltf (a fuzz seed): STEP translation
+// of the skin's root joint, LINEAR rotation of its child, CUBICSPLINE
+// morph weights with zero tangents (smoothstep between keys).
+TEST(Animation, GeneratedSeedPlaysEveryKind) {
+  const std::string path = test::testDataPath("malformed/valid/animated.gltf");
+  struct Case {
+    double time;
+    glm::dvec3 lo, hi;
+  };
+  for (const Case& c : {Case{0.0, {0, 0, 0}, {1, 1, 0}}, Case{1.0, {0.5, 0, 1}, {1.5, 1.5, 1}},
+                        Case{0.5, {0, 0, 0.5}, {1, 1 + 0.5 * std::sqrt(0.5), 0.5}},
+                        Case{9.0, {0, 0.5, 0.5}, {1, 1.5, 0.5}}}) {
+    const Scene s = loadAt(path, c.time);
+    expectNear(s.bounds.lo, c.lo, "lo");
+    expectNear(s.bounds.hi, c.hi, "hi");
+  }
+}
+
 // ---- refusals: one InputError naming the file and the element ----------
 
 std::string refusal(const std::string& path, std::optional<double> time = 0.0, int animation = -1) {
