@@ -913,9 +913,13 @@ bool SceneBuilder::applyMorphTargets(const json& prim, const std::string& e,
 bool SceneBuilder::applySkin(const json& prim, const std::string& e, size_t skin, VertexData& v) {
   const std::vector<glm::dmat4>& joints = jointMatrices(skin);
   const json& attributes = prim.at("attributes");
-  std::vector<glm::dmat4> skinMatrix(v.count, glm::dmat4(0.0));
-  std::vector<double> weightSum(v.count, 0.0);
-  // JOINTS_0/WEIGHTS_0, JOINTS_1/WEIGHTS_1, ...: four influences per set.
+  // JOINTS_0/WEIGHTS_0, JOINTS_1/WEIGHTS_1, ...: four influences per set,
+  // read and checked first; then one blended matrix per vertex at a time.
+  struct Influences {
+    std::vector<double> joint, weight;
+    std::string weightElement;
+  };
+  std::vector<Influences> sets;
   for (int set = 0;; ++set) {
     const std::string jn = "JOINTS_" + std::to_string(set), wn = "WEIGHTS_" + std::to_string(set);
     if (!attributes.contains(jn) || !attributes.contains(wn)) break;
@@ -926,29 +930,37 @@ bool SceneBuilder::applySkin(const json& prim, const std::string& e, size_t skin
     if (jct != 5121 && jct != 5123)
       fail(je, "componentType " + std::to_string(jct) + " must be 5121 or 5123");
     size_t components = 0;
-    const std::vector<double> index = readAccessor(ja, e + " " + jn, {"VEC4"}, &components);
-    const std::vector<double> weight = readAccessor(wa, e + " " + wn, {"VEC4"}, &components);
-    if (index.size() != 4 * v.count)
-      fail(je, "has " + std::to_string(index.size() / 4) + " elements, POSITION " + std::to_string(v.count));
-    if (weight.size() != 4 * v.count)
-      fail(we, "has " + std::to_string(weight.size() / 4) + " elements, POSITION " + std::to_string(v.count));
+    Influences in{readAccessor(ja, e + " " + jn, {"VEC4"}, &components),
+                  readAccessor(wa, e + " " + wn, {"VEC4"}, &components), we};
+    if (in.joint.size() != 4 * v.count)
+      fail(je,
+           "has " + std::to_string(in.joint.size() / 4) + " elements, POSITION " + std::to_string(v.count));
+    if (in.weight.size() != 4 * v.count)
+      fail(we,
+           "has " + std::to_string(in.weight.size() / 4) + " elements, POSITION " + std::to_string(v.count));
     for (size_t i = 0; i < 4 * v.count; ++i) {
-      if (index[i] >= double(joints.size()))
-        fail(je, "vertex " + std::to_string(i / 4) + " names joint " + std::to_string(uint64_t(index[i])) +
+      if (in.joint[i] >= double(joints.size()))
+        fail(je, "vertex " + std::to_string(i / 4) + " names joint " + std::to_string(uint64_t(in.joint[i])) +
                      "; skin " + std::to_string(skin) + " has " + std::to_string(joints.size()) + " joints");
-      if (weight[i] < 0.0) fail(we, "vertex " + std::to_string(i / 4) + " has a negative weight");
-      if (weight[i] == 0.0) continue;
-      skinMatrix[i / 4] += weight[i] * joints[size_t(index[i])];
-      weightSum[i / 4] += weight[i];
+      if (in.weight[i] < 0.0) fail(we, "vertex " + std::to_string(i / 4) + " has a negative weight");
     }
+    sets.push_back(std::move(in));
   }
   size_t mirroring = 0;
   for (size_t i = 0; i < v.count; ++i) {
+    glm::dmat4 m(0.0);
+    double weightSum = 0.0;
+    for (const Influences& in : sets)
+      for (size_t k = 4 * i; k < 4 * i + 4; ++k)
+        if (in.weight[k] != 0.0) {
+          m += in.weight[k] * joints[size_t(in.joint[k])];
+          weightSum += in.weight[k];
+        }
     // Weights should sum to 1; exporters round (and 8-bit weights cannot
     // say 1/3): normalise.
-    if (!(weightSum[i] > 0.0))
-      fail(e + " WEIGHTS_0", "vertex " + std::to_string(i) + " has weights summing to 0");
-    const glm::dmat4 m = skinMatrix[i] / weightSum[i];
+    if (!(weightSum > 0.0))
+      fail(sets.front().weightElement, "vertex " + std::to_string(i) + " has weights summing to 0");
+    m /= weightSum;
     const glm::dvec3 p =
         glm::dvec3(m * glm::dvec4(v.positions[3 * i], v.positions[3 * i + 1], v.positions[3 * i + 2], 1.0));
     std::copy_n(&p.x, 3, &v.positions[3 * i]);
@@ -957,7 +969,7 @@ bool SceneBuilder::applySkin(const json& prim, const std::string& e, size_t skin
     mirroring += det < 0.0;
     if (!v.normals.empty()) {
       // The inverse transpose, as the cofactor matrix (defined when m3 is
-      // singular; its sign kept by det), renormalised by appendVertices.
+      // singular; its sign kept by det), renormalised.
       const glm::dmat3 cofactor(glm::cross(m3[1], m3[2]), glm::cross(m3[2], m3[0]), glm::cross(m3[0], m3[1]));
       glm::dvec3 n = (det < 0.0 ? -1.0 : 1.0) *
                      (cofactor * glm::dvec3(v.normals[3 * i], v.normals[3 * i + 1], v.normals[3 * i + 2]));

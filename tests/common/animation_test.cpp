@@ -413,6 +413,15 @@ TEST(AnimationRefusals, NaNSkinWeightsAndWrongMorphWeightCount) {
   b.doc["skins"] = {{{"joints", {1}}}};
   EXPECT_EQ(refusal(b.write("nan-weights"), std::nullopt),
             "mesh 0 primitive 0 WEIGHTS_0 (accessor 1): element 1 component 0 is NaN");
+  GltfBuilder z;
+  const int zj = z.u16({0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, "VEC4");
+  const int zw = z.floats({1, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0}, "VEC4");
+  z.meshNode(kTriangle, {0, 1, 2}, {{"JOINTS_0", zj}, {"WEIGHTS_0", zw}});
+  z.doc["nodes"][0]["skin"] = 0;
+  z.doc["nodes"].push_back(json::object());
+  z.doc["skins"] = {{{"joints", {1}}}};
+  EXPECT_EQ(refusal(z.write("zero-weights"), std::nullopt),
+            "mesh 0 primitive 0 WEIGHTS_0 (accessor 1): vertex 1 has weights summing to 0");
   std::string morph = morphCube(true, false);
   json doc = json::parse(test::slurp(morph));
   doc["nodes"][0]["weights"] = {0.5, 0.5, 0.5};
