@@ -289,7 +289,8 @@ TEST(RenderOptions, AllRenderersAcceptWhatAppliesToOne) {
 TEST(RenderOptions, AnimationNeedsTime) {
   const auto error = finishWith({"--animation", "1"}, false);
   ASSERT_TRUE(error);
-  EXPECT_EQ(std::string(error->what()), "command line: --animation: chooses what --time plays: give --time too");
+  EXPECT_EQ(std::string(error->what()),
+            "command line: --animation: chooses what --time plays: give --time too");
   RenderSettings s;
   ASSERT_FALSE(finishWith({"--time", "1.5", "--animation", "all"}, false, &s));
   EXPECT_EQ(s.pose.time, 1.5);
