@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import rastray
-from conftest import run_cli, scene_path
+from conftest import cli_json, run_cli, scene_path
 
 RENDERERS = ["raster", "raytrace", "hybrid"]
 
@@ -110,3 +110,7 @@ def test_time_poses_the_scene_as_the_command_line_does(tmp_path):
     run_cli("render", SKIN, "-o", out, "--float", *bent.args)
     assert same_bits(bent.color, rastray.read_exr(out).color)
     assert same_bits(rastray.render(scene, time=2, **camera).color, bent.color)
+    # info at a time is the command line's info --time.
+    info = scene.info(time=2)
+    assert info["bounds"] == cli_json("info", SKIN, "--json", "--time", "2")["bounds"]
+    assert info["bounds"] != scene.info()["bounds"]
