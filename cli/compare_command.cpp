@@ -48,16 +48,18 @@ void requireColorFor(const CompareResult& result, const CompareCommandOptions& o
 }
 
 int runCompare(CompareCommandOptions& opt) {
-  opt.camera = opt.renderCli.settings(/*allRenderers=*/false).camera;
+  const RenderSettings settings = opt.renderCli.settings(/*allRenderers=*/false);
+  opt.camera = settings.camera;
   // Camera options other than the planes only make sense with the scene's
   // camera; silently ignoring them would misstate the classification.
   if (opt.scene.empty()) {
     const CameraOverrides o = opt.camera.overrides();
-    const char* needsScene = o.eye           ? "--eye"
-                             : o.target      ? "--target"
-                             : o.up          ? "--up"
-                             : o.yfovDegrees ? "--yfov"
-                                             : nullptr;
+    const char* needsScene = o.eye                ? "--eye"
+                             : o.target           ? "--target"
+                             : o.up               ? "--up"
+                             : o.yfovDegrees      ? "--yfov"
+                             : settings.pose.time ? "--time"
+                                                  : nullptr;
     if (needsScene) throw InputError("command line", needsScene, "needs --scene");
   }
   CompareInputs in;
@@ -65,6 +67,7 @@ int runCompare(CompareCommandOptions& opt) {
   in.pathB = opt.b;
   in.scenePath = opt.scene;
   in.camera = opt.camera.overrides();
+  in.pose = settings.pose;
   in.spp = opt.spp;
   in.depthFormat = *parseDepthFormat(opt.depthFormat);  // CLI11 checked the spelling
   in.edgeDistance = opt.edgeDistance;

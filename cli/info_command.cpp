@@ -30,8 +30,10 @@ struct InfoOptions {
 };
 
 int runInfo(InfoOptions& opt) {
-  opt.camera = opt.renderCli.settings(/*allRenderers=*/false).camera;
-  const Scene scene = loadScene(opt.scenePath);
+  const RenderSettings settings = opt.renderCli.settings(/*allRenderers=*/false);
+  opt.camera = settings.camera;
+  // At --time, the bounds and the default camera are the pose's.
+  const Scene scene = loadScene(opt.scenePath, MemoryBudget::machineDefault(), settings.pose);
   const SceneAnalysis analysis = analyzeScene(scene);
   const Camera camera = makeCamera(scene, opt.camera.overrides(), opt.camera.width(), opt.camera.height());
   const MaterialCounts mc = countMaterials(scene);
@@ -72,6 +74,10 @@ int runInfo(InfoOptions& opt) {
     std::printf("  camera %-3zu %s\n", i,
                 c ? c->describe().c_str() : (scene.cameras[i].origin + ": " + error).c_str());
   }
+  if (!scene.animations.empty())
+    std::printf("animations %zu (--time plays them; without it none plays)\n", scene.animations.size());
+  for (size_t i = 0; i < scene.animations.size(); ++i)
+    std::printf("  animation %-3zu %s\n", i, describeAnimation(scene.animations[i]).c_str());
   if (scene.bounds.empty())
     std::printf("bounds     empty (nothing to render: background only)\n");
   else

@@ -6,9 +6,11 @@ namespace rastray {
 
 namespace {
 
+// The camera rows and the pose (--time, --animation): what a command that
+// looks at the scene without rendering it needs to see the same scene.
 bool isCameraRow(const RenderOptionSpec& spec) {
-  static const std::set<std::string> kCamera = {"--camera", "--eye",   "--target", "--up",
-                                                "--yfov",   "--znear", "--zfar",   "--size"};
+  static const std::set<std::string> kCamera = {"--camera", "--eye",  "--target", "--up",   "--yfov",
+                                                "--znear",  "--zfar", "--size",   "--time", "--animation"};
   return kCamera.count(spec.name) > 0;
 }
 

@@ -20,7 +20,7 @@ class RenderOptionsCli {
  public:
   enum class Rows {
     All,
-    Camera,  // the SPEC §2 camera options and --size (info, compare)
+    Camera,  // the SPEC §2 camera options, --size and the pose --time, --animation (info, compare)
   };
   // Registers --renderer (when `withRenderer`) and the rows, but those in `except`.
   void add(CLI::App& cmd, bool withRenderer, Rows rows = Rows::All, const std::set<std::string>& except = {});

@@ -135,7 +135,7 @@ int runSweep(const SweepOptions& opt) {
   if (spec.reference == "auto") {
     meta.reference = "auto: " + std::string("the ray caster with");
     for (const std::string& a : sweep::autoReferenceArgs()) meta.reference += " " + a;
-    meta.reference += ", at each cell's --size, camera options and --cull";
+    meta.reference += ", at each cell's --size, camera options, --cull and pose (--time, --animation)";
   } else {
     if (spec.scenes.size() > 1)
       throw InputError("command line", "--reference",

@@ -159,8 +159,15 @@ struct Instance {
   uint32_t primitive = 0;  // index within the mesh
   uint32_t material = 0;   // index into Scene::materials (always valid)
   int mode = 4;            // glTF primitive mode: 4 TRIANGLES, 5 STRIP, 6 FAN
+  // The node's world matrix; identity for a skinned instance, whose
+  // vertices the skin places in world space (the node's own transform is
+  // ignored, as glTF requires).
   glm::dmat4 worldFromObject{1.0};
-  bool mirrored = false;  // det(worldFromObject) < 0: winding was swapped
+  // det(worldFromObject) < 0 (skinned: the skin matrix of most vertices
+  // mirrors): winding was swapped.
+  bool mirrored = false;
+  bool skinned = false;  // placed by a skin (joint matrices), not by worldFromObject
+  bool morphed = false;  // morph-target deltas with a nonzero weight were added
   NormalSource normals = NormalSource::Flat;
   bool hasTexcoords = false;  // false: texcoords are all (0, 0)
   bool hasColors = false;     // COLOR_0 read into Scene::colors; false: white
@@ -176,6 +183,26 @@ struct IgnoredFeature {
   std::string unit;     // singular: "material", "textureInfo", "primitive", ...
   uint32_t count = 0;
   std::string describe() const;  // "<feature> on <count> <unit>(s)"
+};
+
+// Which pose of the file the scene is flattened at (--time, --animation;
+// common/gltf/animation.h samples it).
+struct PoseRequest {
+  // Seconds; nullopt: no animation plays (the nodes' own transforms and
+  // morph weights, skins applied).
+  std::optional<double> time;
+  int animation = -1;  // -1: every animation plays; else only this one
+  bool operator==(const PoseRequest& o) const { return time == o.time && animation == o.animation; }
+  bool operator!=(const PoseRequest& o) const { return !(*this == o); }
+};
+
+// One animation of the file, as `info` lists it. Times in seconds.
+struct AnimationSummary {
+  std::string name;
+  uint32_t channels = 0;
+  uint32_t samplers = 0;
+  double start = 0.0;  // the smallest key time of its samplers
+  double end = 0.0;    // the largest: the animation's duration, glTF time starting at 0
 };
 
 // Counts of what the file holds, for `rastray info`.
@@ -227,6 +254,10 @@ struct Scene {
   // What the file uses and no renderer draws, in the order first met;
   // empty when nothing is ignored.
   std::vector<IgnoredFeature> ignored;
+  // The file's animations (all of them, played or not) and the pose the
+  // store was flattened at.
+  std::vector<AnimationSummary> animations;
+  PoseRequest pose;
 
   const Instance& instanceOf(uint32_t instance) const { return instances[instance]; }
   // Stored vertex indices of (instance, triangle).

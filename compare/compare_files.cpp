@@ -139,7 +139,7 @@ CompareResult compareFiles(const CompareInputs& in) {
   std::optional<Scene> scene;
   std::optional<Camera> camera;
   if (!in.scenePath.empty()) {
-    scene = loadScene(in.scenePath);
+    scene = loadScene(in.scenePath, MemoryBudget::machineDefault(), in.pose);
     // As `render` and `crossval` do by default (--origin camera).
     applyRenderOrigin(*scene, RenderOrigin::Camera, in.camera);
     camera = makeCamera(*scene, in.camera, width, height);

@@ -22,6 +22,7 @@ namespace rastray {
 struct CompareInputs {
   std::string pathA, pathB;
   std::string scenePath;  // empty: image-space classification
+  PoseRequest pose;       // the scene's pose (--time, --animation), as the files were rendered
   CameraOverrides
       camera;   // applied to the scene's camera; znear/zfar alone also set the planes without a scene
   int spp = 0;  // 0: not given

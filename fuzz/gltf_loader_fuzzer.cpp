@@ -2,7 +2,8 @@
 // (loadSceneFromMemory: the same document, check, resource and scene-
 // builder steps as loadScene), then what every render does next with the
 // scene before a renderer gets it: the analysis (SPEC §8) with its texture
-// decoding and mip chains, the rebase on the camera's eye and the camera.
+// decoding and mip chains, the rebase on the camera's eye and the camera;
+// a file with animations is loaded again at a time they play.
 //
 // An InputError is the loader refusing bad input (exit 2 on the command
 // line) and is a normal outcome. A crash, a sanitizer report, a failed
@@ -57,6 +58,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const rastray::CameraOverrides none;
     rastray::applyRenderOrigin(scene, rastray::RenderOrigin::Camera, none);
     rastray::makeCamera(scene, none, 64, 48);
+    // A file with animations is posed too, at a time from its first byte
+    // beyond the keys as often as within them (common/gltf/animation.h:
+    // sampling, clamping, the pose's joint matrices and morph weights).
+    if (!scene.animations.empty()) {
+      rastray::PoseRequest pose;
+      pose.time = (double(data[0]) - 32.0) / 16.0;
+      rastray::loadSceneFromMemory(path, std::vector<uint8_t>(data, data + size), budget, pose);
+    }
   } catch (const rastray::InputError&) {
     // Refused with a message: what the loader is for.
   }

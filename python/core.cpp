@@ -190,9 +190,12 @@ struct PyScene {
 };
 
 // The scene prepared for `settings` (selectLights, render origin), as
-// loadSceneForRender gives the command line.
+// loadSceneForRender gives the command line. Another pose (time=,
+// animation=) than the one loaded loads the file again at that pose.
 std::shared_ptr<const Scene> prepared(const PyScene& s, const RenderSettings& settings) {
-  auto scene = std::make_shared<Scene>(*s.scene);
+  auto scene = settings.pose == s.scene->pose
+                   ? std::make_shared<Scene>(*s.scene)
+                   : std::make_shared<Scene>(loadScene(s.scene->path, settings.memory, settings.pose));
   prepareSceneForRender(*scene, settings);
   return scene;
 }
@@ -495,14 +498,19 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("path", [](const PyScene& s) { return s.scene->path; })
       .def("info_json",
            [](const PyScene& s, const std::vector<std::string>& args) {
-             // `info` takes the camera rows only (--camera to --size).
-             static const std::set<std::string> kCamera = {"--camera", "--eye",   "--target", "--up",
-                                                           "--yfov",   "--znear", "--zfar",   "--size"};
+             // `info` takes the camera rows only (--camera to --size) and
+             // the pose (--time, --animation), as the command line's.
+             static const std::set<std::string> kCamera = {"--camera", "--eye",      "--target", "--up",
+                                                           "--yfov",   "--znear",    "--zfar",   "--size",
+                                                           "--time",   "--animation"};
              for (const std::string& word : args)
                if (word.rfind("--", 0) == 0 && !kCamera.count(word))
                  throw InputError("command line", word,
                                   "info takes the camera options only (camera to size)");
              const RenderSettings settings = renderSettingsFrom(args, /*allRenderers=*/false);
+             if (settings.pose != s.scene->pose)  // another frame: loaded at its pose, as `info --time`
+               return fromJson(sceneInfoJson(
+                   loadScene(s.scene->path, MemoryBudget::machineDefault(), settings.pose), settings.camera));
              return fromJson(sceneInfoJson(*s.scene, settings.camera));
            })
       .def("__repr__", [](const PyScene& s) {

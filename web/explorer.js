@@ -500,6 +500,7 @@ function readControls() {
   for (const c of controls()) {
     const name = c.dataset.option;
     if (name === 'shadow-bias') continue;
+    if (name === 'time' && $('time-label').hidden) { delete o.time; continue; } // no animations
     if (c.type === 'checkbox') { if (c.checked) o[name] = 'on'; continue; }
     o[name] = name === 'transparency' && c.value === 'peel' ? 'peel:' + $('peel-layers').value : c.value;
   }
@@ -524,6 +525,7 @@ function writeControls() {
     const value = state.options[name] !== undefined ? state.options[name] : (info ? info.default : '');
     if (c.type === 'checkbox') c.checked = value === 'on';
     else if (name === 'shadow-bias') c.value = value ? value.split(',')[Number(c.dataset.index)] || '' : '';
+    else if (name === 'time') { c.value = value || '0'; $('time-value').textContent = c.value; }
     else if (name === 'transparency' && value.startsWith('peel:')) { c.value = 'peel'; $('peel-layers').value = value.slice(5); }
     else if (c.tagName === 'INPUT') c.value = value;
     else if (value !== '' || name === 'shadows') c.value = value;
@@ -654,6 +656,19 @@ async function loadScene(keepCamera) {
   if (state.cameraIndex !== null && !(state.cameraIndex < (state.sceneInfo.cameras || []).length)) state.cameraIndex = null;
   writeCameraPick();
   writeLights();
+  writeTimeSlider();
+}
+
+// The time slider (--time) runs over the scene's longest animation, as
+// /api/scene reports it; hidden for a scene without animations.
+function writeTimeSlider() {
+  const duration = state.sceneInfo.duration || 0;
+  const slider = document.querySelector('[data-option="time"]');
+  $('time-label').hidden = !(state.sceneInfo.animations || []).length;
+  slider.max = String(duration > 0 ? duration : 1);
+  slider.step = String((duration > 0 ? duration : 1) / 200);
+  if (state.options.time !== undefined) slider.value = state.options.time;
+  $('time-value').textContent = slider.value;
 }
 
 function bindEvents() {
@@ -665,6 +680,8 @@ function bindEvents() {
     state.scene = $('scene').value;
     clearExplain();
     delete state.options.lights; // another scene's light indices
+    delete state.options.time; // and its animations
+    delete state.options.animation;
     await loadScene(false);
     requestFrame(false);
   });
@@ -677,6 +694,8 @@ function bindEvents() {
     requestFrame(false);
   });
   $('swipe').addEventListener('input', applySwipe);
+  const time = document.querySelector('[data-option="time"]');
+  time.addEventListener('input', () => { $('time-value').textContent = time.value; });
   $('copy').addEventListener('click', () => navigator.clipboard.writeText($('command').textContent));
   const stage = $('stage');
   stage.addEventListener('mousedown', onMouseDown);

@@ -240,6 +240,16 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
      RASTRAY_PARSE(s.camera.size = {parseInt("--size", v[0], 1, kMaxImageSide),
                                     parseInt("--size", v[1], 1, kMaxImageSide)}),
      RASTRAY_FORMAT(return {std::to_string(s.camera.width()), std::to_string(s.camera.height())})},
+    // The pose (common/gltf/animation.h): the scene is flattened at it.
+    {"--time", kAllRenderers, OptionCondition::Always,
+     "Play the file's animations to this time in seconds (clamped to each animation's keys; `info` lists "
+     "their durations); not given, none plays",
+     1, "0.5", RASTRAY_PARSE(s.pose.time = parseDoubleIn("--time", v[0], -1e9, 1e9)),
+     RASTRAY_FORMAT(if (!s.pose.time) return {}; return {formatDouble(*s.pose.time)})},
+    {"--animation", kAllRenderers, OptionCondition::Always,
+     "Which animation --time plays: all, or its index as `info` lists it", 1, "0",
+     RASTRAY_PARSE(s.pose.animation = v[0] == "all" ? -1 : parseInt("--animation", v[0], 0, 1 << 30)),
+     RASTRAY_FORMAT(return {s.pose.animation < 0 ? "all" : std::to_string(s.pose.animation)})},
     // Every renderer.
     {"--spp", kAllRenderers, OptionCondition::Always, "Samples per pixel", 1, "4",
      RASTRAY_PARSE(s.spp = parseInt("--spp", v[0], INT32_MIN, INT32_MAX)),
@@ -531,6 +541,8 @@ void RenderSettings::finish() {
   if (!isSupportedSampleCount(spp))
     badOption("--spp", std::to_string(spp) + " is not supported (use " + supportedSampleCounts() + ")");
   if (!isGiven("--max-memory")) memory = MemoryBudget::machineDefault();
+  if (isGiven("--animation") && !pose.time)
+    badOption("--animation", "chooses what --time plays: give --time too");
 
   // Shadows: map needs the rasterizer, rays a ray tracer, none applies to
   // every renderer (the ray caster then traces no shadow rays, nor does

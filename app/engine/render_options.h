@@ -19,6 +19,7 @@
 #include "app/engine/cli_options.h"
 #include "common/memory_budget.h"
 #include "common/render_output.h"
+#include "common/scene.h"
 #include "common/shading.h"
 #include "raster/options.h"
 #include "raytrace/ray_caster.h"
@@ -92,6 +93,7 @@ struct RenderSettings {
   bool keepSamples = false;
   std::optional<glm::ivec2> debugPixel;
   RenderOrigin renderOrigin = RenderOrigin::Camera;
+  PoseRequest pose;                               // --time, --animation: the pose the scene is loaded at
   std::optional<std::vector<size_t>> keptLights;  // --lights: nullopt keeps all; sorted, unique
   // --shadows as given; nullopt: map for the rasterizer, rays for the ray
   // caster and hybrid. finish() turns it into raster.shadows.

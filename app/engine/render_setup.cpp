@@ -39,7 +39,7 @@ void prepareSceneForRender(Scene& scene, const RenderSettings& settings) {
 }
 
 Scene loadSceneForRender(const std::string& path, const RenderSettings& settings) {
-  Scene scene = loadScene(path, settings.memory);
+  Scene scene = loadScene(path, settings.memory, settings.pose);
   prepareSceneForRender(scene, settings);
   return scene;
 }

@@ -1,6 +1,7 @@
 #include "app/engine/scene_info.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "common/analysis.h"
 #include "common/error.h"
@@ -54,6 +55,14 @@ std::string describeLight(const Light& l) {
          std::to_string(l.node);
 }
 
+std::string describeAnimation(const AnimationSummary& a) {
+  char keys[96];
+  std::snprintf(keys, sizeof keys, "keys %.6g .. %.6g s", a.start, a.end);
+  return (a.name.empty() ? std::string("unnamed") : "'" + a.name + "'") + ": " + std::to_string(a.channels) +
+         " channel" + (a.channels == 1 ? "" : "s") + ", " + std::to_string(a.samplers) + " sampler" +
+         (a.samplers == 1 ? "" : "s") + ", " + keys;
+}
+
 nlohmann::json sceneInfoJson(const Scene& scene, const CameraOptions& options) {
   const SceneAnalysis analysis = analyzeScene(scene);
   const Camera camera = makeCamera(scene, options.overrides(), options.width(), options.height());
@@ -105,6 +114,20 @@ nlohmann::json sceneInfoJson(const Scene& scene, const CameraOptions& options) {
     lightList.push_back(e);
   }
   j["lightList"] = lightList;
+  // The file's animations (--animation N; --time plays them), with their
+  // key ranges in seconds: "duration" is the last key (glTF time starts at 0).
+  nlohmann::json animations = nlohmann::json::array();
+  for (size_t i = 0; i < scene.animations.size(); ++i) {
+    const AnimationSummary& a = scene.animations[i];
+    animations.push_back({{"index", i},
+                          {"name", a.name},
+                          {"channels", a.channels},
+                          {"samplers", a.samplers},
+                          {"start", a.start},
+                          {"duration", a.end},
+                          {"text", describeAnimation(a)}});
+  }
+  j["animations"] = animations;
   j["cameras"] = scene.stats.cameras;
   j["cameraNodes"] = scene.stats.cameraNodes;
   // Every camera node in walk order, as --camera N picks it (no other overrides).
@@ -158,7 +181,9 @@ nlohmann::json sceneInfoJson(const Scene& scene, const CameraOptions& options) {
                     {"degenerate", in.degenerateCount},
                     {"mirrored", in.mirrored},
                     {"normals", in.normals == NormalSource::Authored ? "authored" : "flat"},
-                    {"vertexColors", in.hasColors}});
+                    {"vertexColors", in.hasColors},
+                    {"skinned", in.skinned},
+                    {"morphed", in.morphed}});
   }
   j["instanceList"] = inst;
   return j;

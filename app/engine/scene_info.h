@@ -27,6 +27,10 @@ std::optional<Camera> fileCamera(const Scene& scene, size_t i, int width, int he
 // "point 'Lamp' node 4": a light as `info` lists it (its index is --lights').
 std::string describeLight(const Light& l);
 
+// "'Walk': 3 channels, 3 samplers, keys 0 .. 1.25 s": an animation as
+// `info` lists it (its index is --animation's).
+std::string describeAnimation(const AnimationSummary& a);
+
 // Schema "rastray.info" version 1, as `rastray info --json` prints it: the
 // scene's counts, lights, cameras, bounds, the camera `camera` selects, the
 // work analysis and the instances. Throws InputError when the camera

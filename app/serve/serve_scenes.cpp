@@ -86,16 +86,25 @@ std::vector<std::string> SceneAccess::list() const {
   return out;
 }
 
-std::shared_ptr<const Scene> SceneCache::loaded(const std::string& path) {
-  if (auto scene = loaded_.find(path)) return scene;
+std::shared_ptr<const Scene> SceneCache::loaded(const std::string& path, const PoseRequest& pose) {
+  const std::string key = path + poseKey(pose);
+  if (auto scene = loaded_.find(key)) return scene;
   // Through the render command's own loader and default settings, in the
   // file's frame (a fresh scene's origin is (0, 0, 0): --origin world
   // rebases nothing).
   RenderSettings world = renderSettingsFrom({"--origin", "world"});
   if (loadBudget) world.memory = *loadBudget;
+  world.pose = pose;
   auto scene = std::make_shared<const Scene>(loadSceneForRender(path, world));
-  loaded_.insert(path, scene);
+  loaded_.insert(key, scene);
   return scene;
+}
+
+std::string SceneCache::poseKey(const PoseRequest& pose) {
+  if (!pose.time) return "";
+  char key[64];
+  std::snprintf(key, sizeof key, "\x1ftime %.17g animation %d", *pose.time, pose.animation);
+  return key;
 }
 
 std::shared_ptr<const Scene> SceneCache::prepared(const std::string& path, const RenderSettings& settings) {
@@ -103,7 +112,7 @@ std::shared_ptr<const Scene> SceneCache::prepared(const std::string& path, const
   if (auto scene = prepared_.find(key)) return scene;
   // A copy of the loaded scene prepared as loadSceneForRender prepares a
   // freshly loaded one: rebaseScene rounds again from worldPositions.
-  Scene scene = *loaded(path);
+  Scene scene = *loaded(path, settings.pose);
   prepareSceneForRender(scene, settings);
   auto shared = std::make_shared<const Scene>(std::move(scene));
   prepared_.insert(key, shared);
@@ -129,7 +138,7 @@ std::string SceneCache::preparedKey(const std::string& path, const RenderSetting
         "\x1f"
         "camera " +
         std::to_string(*overrides.camera);
-  key += "\x1flights " + optionText(settings, "--lights");
+  key += "\x1flights " + optionText(settings, "--lights") + poseKey(settings.pose);
   return key;
 }
 
@@ -256,6 +265,14 @@ nlohmann::ordered_json sceneInfoJson(const Scene& scene, int width, int height) 
                       {"name", scene.lights[i].name},
                       {"type", toString(scene.lights[i].type)},
                       {"node", scene.lights[i].node}});
+  // The explorer's time slider runs over [0, the longest duration].
+  nlohmann::ordered_json animations = nlohmann::ordered_json::array();
+  double duration = 0.0;
+  for (size_t i = 0; i < scene.animations.size(); ++i) {
+    const AnimationSummary& a = scene.animations[i];
+    animations.push_back({{"index", i}, {"name", a.name}, {"channels", a.channels}, {"duration", a.end}});
+    duration = std::max(duration, a.end);
+  }
   return {{"schema", "rastray.serve.scene"},
           {"version", 1},
           {"scene", scene.path},
@@ -267,7 +284,9 @@ nlohmann::ordered_json sceneInfoJson(const Scene& scene, int width, int height) 
           {"bounds", bounds},
           {"size", scene.bounds.empty() ? 1.0 : glm::length(scene.bounds.hi - scene.bounds.lo)},
           {"camera", orbitCameraJson(scene, makeCamera(scene, {}, width, height))},
-          {"cameras", cameras}};
+          {"cameras", cameras},
+          {"animations", animations},
+          {"duration", duration}};
 }
 
 }  // namespace rastray::serve

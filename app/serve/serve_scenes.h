@@ -109,8 +109,9 @@ class SceneCache {
   // The limit scene loads are checked against (serve --max-memory);
   // nullopt: MemoryBudget::machineDefault().
   std::optional<MemoryBudget> loadBudget;
-  // The scene as loaded from `path` (its file frame), parsed once.
-  std::shared_ptr<const Scene> loaded(const std::string& path);
+  // The scene as loaded from `path` (its file frame) at `pose`, parsed
+  // once per pose (each --time loads the file again).
+  std::shared_ptr<const Scene> loaded(const std::string& path, const PoseRequest& pose = {});
   // The scene rebased on the render origin `settings` names, exactly as
   // loadSceneForRender gives it.
   std::shared_ptr<const Scene> prepared(const std::string& path, const RenderSettings& settings);
@@ -131,6 +132,8 @@ class SceneCache {
   LruCache<const Scene> prepared_{3};
   // The cache key of prepared(path, settings).
   static std::string preparedKey(const std::string& path, const RenderSettings& settings);
+  // The part of a cache key that names the pose ("" for none).
+  static std::string poseKey(const PoseRequest& pose);
 
   LruCache<PreparedFrame> frames_{4};
   LruCache<SharedCaster> casters_{2};            // per prepared scene and culling mode

@@ -190,9 +190,11 @@ const std::vector<std::string>& autoReferenceArgs() {
   return args;
 }
 
+// What the auto reference renders with the cell: the picture's framing,
+// culling and the pose (an animated scene's reference is the same frame).
 bool definesPicture(const std::string& option) {
-  static const std::set<std::string> picture = {"--size", "--eye",   "--target", "--up",
-                                                "--yfov", "--znear", "--zfar",   "--cull"};
+  static const std::set<std::string> picture = {"--size",  "--eye",  "--target", "--up",   "--yfov",
+                                                "--znear", "--zfar", "--cull",   "--time", "--animation"};
   return picture.count(option) > 0;
 }
 

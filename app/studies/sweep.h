@@ -46,8 +46,9 @@ VaryAxis parseVary(const std::string& text);
 // every transparent layer composited
 // (--transparency-cutoff 0) and secondary rays to depth 16, the rest at
 // their defaults (shadow rays, the file's texture samplers, origin camera,
-// error-bound ray offsets). The cell's image size, camera options and
-// culling are added: they define the picture, not its quality.
+// error-bound ray offsets). The cell's image size, camera options,
+// culling and pose (--time, --animation) are added: they define the
+// picture, not its quality.
 const std::vector<std::string>& autoReferenceArgs();
 // Options a cell passes on to its `auto` reference (picture, not quality).
 bool definesPicture(const std::string& option);

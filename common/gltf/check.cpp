@@ -1,6 +1,7 @@
 #include "common/gltf/check.h"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <set>
@@ -653,6 +654,7 @@ void checkMeshes(const Checker& c, const json& doc, const ViewRanges& views) {
     for (size_t i = 0; i < meshes->size(); ++i) {
       const std::string e = "mesh " + std::to_string(i);
       const json& m = c.object((*meshes)[i], e);
+      c.numberArray(m, "weights", e, 1, SIZE_MAX);
       const json* primitives = c.member(m, "primitives");
       if (!primitives) c.fail(e, "\"primitives\" is missing");
       if (!primitives->is_array())
@@ -665,6 +667,16 @@ void checkMeshes(const Checker& c, const json& doc, const ViewRanges& views) {
         c.object(*attributes, pe + " attributes");
         for (auto it = attributes->begin(); it != attributes->end(); ++it)
           c.index(*attributes, it.key().c_str(), pe + " attributes", "accessors");
+        if (const json* targets = c.member(prim, "targets")) {
+          if (!targets->is_array() || targets->empty())
+            c.fail(pe, "\"targets\" must be a non-empty array of morph targets");
+          for (size_t t = 0; t < targets->size(); ++t) {
+            const std::string te = pe + " target " + std::to_string(t);
+            c.object((*targets)[t], te);
+            for (auto it = (*targets)[t].begin(); it != (*targets)[t].end(); ++it)
+              c.index((*targets)[t], it.key().c_str(), te, "accessors");
+          }
+        }
         const int64_t indices = c.index(prim, "indices", pe, "accessors");
         c.index(prim, "material", pe, "materials");
         const int64_t mode = c.integer(prim, "mode", pe, false, 4);
@@ -776,6 +788,7 @@ void checkNodes(const Checker& c, const json& doc, size_t lightCount) {
       c.numberArray(n, "translation", e, 3, 3);
       c.numberArray(n, "rotation", e, 4, 4);
       c.numberArray(n, "scale", e, 3, 3);
+      c.numberArray(n, "weights", e, 1, SIZE_MAX);
       if (c.member(n, "matrix") &&
           (c.member(n, "translation") || c.member(n, "rotation") || c.member(n, "scale")))
         c.fail(e, "has both \"matrix\" and translation/rotation/scale");
@@ -818,6 +831,76 @@ void checkScenes(const Checker& c, const json& doc) {
   }
 }
 
+// Skins: joints are node indices, at least one; inverseBindMatrices an
+// accessor (its type and count are checked when it is read).
+void checkSkins(const Checker& c, const json& doc) {
+  if (const json* skins = c.objectArray(doc, "skins", "skins")) {
+    for (size_t i = 0; i < skins->size(); ++i) {
+      const std::string e = "skin " + std::to_string(i);
+      const json& s = c.object((*skins)[i], e);
+      c.string(s, "name", e, false);
+      c.index(s, "inverseBindMatrices", e, "accessors");
+      c.index(s, "skeleton", e, "nodes");
+      const json* joints = c.member(s, "joints");
+      if (!joints) c.fail(e, "\"joints\" is missing");
+      if (!joints->is_array())
+        c.fail(e, std::string("\"joints\" must be an array, got ") + typeName(*joints));
+      if (joints->empty()) c.fail(e, "has no joints");
+      for (size_t k = 0; k < joints->size(); ++k) {
+        const json& j = (*joints)[k];
+        if (!j.is_number_integer() || j.get<int64_t>() < 0 || j.get<uint64_t>() >= c.countOf("nodes"))
+          c.fail(e, "\"joints\"[" + std::to_string(k) + "] is not a node index (" +
+                        std::to_string(c.countOf("nodes")) + " nodes)");
+      }
+    }
+  }
+}
+
+// Animations: samplers name input and output accessors and a known
+// interpolation; channels name a sampler of their animation and a node
+// and path. What the data must satisfy (increasing times, output
+// counts, finite values) is checked when it is read (animation.h).
+void checkAnimations(const Checker& c, const json& doc) {
+  if (const json* animations = c.objectArray(doc, "animations", "animations")) {
+    for (size_t i = 0; i < animations->size(); ++i) {
+      const std::string e = "animation " + std::to_string(i);
+      const json& a = c.object((*animations)[i], e);
+      c.string(a, "name", e, false);
+      const json* samplers = c.objectArray(a, "samplers", e);
+      const json* channels = c.objectArray(a, "channels", e);
+      if (!samplers) c.fail(e, "\"samplers\" is missing");
+      if (!channels) c.fail(e, "\"channels\" is missing");
+      for (size_t k = 0; k < samplers->size(); ++k) {
+        const std::string se = e + " sampler " + std::to_string(k);
+        const json& s = c.object((*samplers)[k], se);
+        c.index(s, "input", se, "accessors", true);
+        c.index(s, "output", se, "accessors", true);
+        const std::string interpolation = c.string(s, "interpolation", se, false);
+        if (c.member(s, "interpolation") && interpolation != "STEP" && interpolation != "LINEAR" &&
+            interpolation != "CUBICSPLINE")
+          c.fail(se, "\"interpolation\" \"" + interpolation + "\" is not STEP, LINEAR or CUBICSPLINE");
+      }
+      for (size_t k = 0; k < channels->size(); ++k) {
+        const std::string ce = e + " channel " + std::to_string(k);
+        const json& ch = c.object((*channels)[k], ce);
+        const int64_t sampler = c.integer(ch, "sampler", ce, true);
+        if (size_t(sampler) >= samplers->size())
+          c.fail(ce, "\"sampler\" refers to sampler " + std::to_string(sampler) + ", which does not exist (" +
+                         std::to_string(samplers->size()) + " samplers in " + e + ")");
+        const json* target = c.member(ch, "target");
+        if (!target) c.fail(ce, "\"target\" is missing");
+        c.object(*target, ce + " target");
+        // Without "node" a channel targets something an extension defines
+        // (KHR_animation_pointer): nothing rastray plays.
+        c.index(*target, "node", ce + " target", "nodes");
+        const std::string path = c.string(*target, "path", ce + " target", true);
+        if (path != "translation" && path != "rotation" && path != "scale" && path != "weights")
+          c.fail(ce + " target", "\"path\" \"" + path + "\" is not translation, rotation, scale or weights");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
@@ -836,6 +919,8 @@ void checkGltfDocument(const json& doc, const GltfCheckContext& context) {
   const size_t lightCount = checkLights(c, doc);
   checkNodes(c, doc, lightCount);
   checkScenes(c, doc);
+  checkSkins(c, doc);
+  checkAnimations(c, doc);
 }
 
 }  // namespace rastray

@@ -215,23 +215,24 @@ void loadResources(const GltfDocument& d, tinygltf::Model& model, const MemoryBu
 namespace {
 
 // Steps 2 to 4, the same whichever way the bytes arrived.
-Scene loadDocument(const GltfDocument& document, const MemoryBudget& budget) {
+Scene loadDocument(const GltfDocument& document, const MemoryBudget& budget, const PoseRequest& pose) {
   checkGltfDocument(document.json, document.context);
   tinygltf::Model model;
   loadResources(document, model, budget);
-  return buildScene(document.context.file, document.json, model, budget);
+  return buildScene(document.context.file, document.json, model, budget, pose);
 }
 
 }  // namespace
 
-Scene loadScene(const std::string& path, const MemoryBudget& budget) {
-  return loadDocument(readGltfDocument(path), budget);
+Scene loadScene(const std::string& path, const MemoryBudget& budget, const PoseRequest& pose) {
+  return loadDocument(readGltfDocument(path), budget, pose);
 }
 
 Scene loadScene(const std::string& path) { return loadScene(path, MemoryBudget::machineDefault()); }
 
-Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes, const MemoryBudget& budget) {
-  return loadDocument(parseGltfDocument(path, std::move(bytes)), budget);
+Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes, const MemoryBudget& budget,
+                          const PoseRequest& pose) {
+  return loadDocument(parseGltfDocument(path, std::move(bytes)), budget, pose);
 }
 
 Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes) {

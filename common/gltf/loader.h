@@ -21,14 +21,19 @@ namespace rastray {
 // (SPEC §7); never returns a partially checked scene. Decoded images and
 // the flattened store (meshes times the nodes that instance them) are
 // estimated before they are allocated and refused above `budget`.
-Scene loadScene(const std::string& path, const MemoryBudget& budget);
+// `pose`: the animation time and animation the scene is flattened at
+// (common/gltf/animation.h); by default none plays (skins and morph
+// weights still apply). An --animation index the file does not have is an
+// InputError naming the command line's --animation.
+Scene loadScene(const std::string& path, const MemoryBudget& budget, const PoseRequest& pose = {});
 // With the machine's default budget (MemoryBudget::machineDefault()).
 Scene loadScene(const std::string& path);
 
 // The same for a file's bytes already in memory (the fuzz target's entry;
 // fuzz/gltf_loader_fuzzer.cpp): `path` names the file in messages, and
 // external buffers and images are resolved beside it, as for loadScene.
-Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes, const MemoryBudget& budget);
+Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes, const MemoryBudget& budget,
+                          const PoseRequest& pose = {});
 // With the machine's default budget.
 Scene loadSceneFromMemory(const std::string& path, std::vector<uint8_t> bytes);
 

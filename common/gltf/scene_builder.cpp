@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/error.h"
+#include "common/gltf/animation.h"
 #include "common/gltf/check.h"
 #include "common/gltf/compression.h"
 #include "common/gltf/document.h"
@@ -36,8 +37,8 @@ int64_t texCoordOf(const json& textureInfo);
 class SceneBuilder {
  public:
   SceneBuilder(const std::string& path, const json& doc, const tinygltf::Model& model,
-               const MemoryBudget& budget)
-      : path_(path), doc_(doc), model_(model), budget_(budget) {}
+               const MemoryBudget& budget, const PoseRequest& pose)
+      : path_(path), doc_(doc), model_(model), budget_(budget), pose_(pose) {}
 
   Scene build();
 
@@ -56,8 +57,22 @@ class SceneBuilder {
     return it == obj.end() ? fallback : it->get<T>();
   }
 
+  // The node's matrix at the requested pose (its own TRS where no played
+  // channel sets it).
   glm::dmat4 localMatrix(size_t node) const;
   void checkNodeGraph(std::vector<int64_t>& parent) const;
+  // Reads and checks every animation (animations_, Scene::animations) and
+  // samples the requested pose (pose_, nodePose_).
+  void loadAnimations();
+  // The world matrix of any node at the pose, reached from the scene or
+  // not (a skin's joints need not be); memoised in world_.
+  const glm::dmat4& worldOf(size_t node);
+  // skin's joint matrices globalJoint · inverseBind, in double; memoised.
+  const std::vector<glm::dmat4>& jointMatrices(size_t skin);
+  // The morph weights of (node, mesh) at the pose: an animated weights
+  // channel, else the node's "weights", else the mesh's, else zeros;
+  // `targets` per primitive.
+  std::vector<double> morphWeights(size_t node, size_t mesh, size_t targets) const;
   std::vector<size_t> rootNodes(const std::vector<int64_t>& parent);
   void reserveFlattenedScene(const std::vector<size_t>& roots);
   void walk(const std::vector<size_t>& roots);
@@ -69,6 +84,14 @@ class SceneBuilder {
     std::vector<double> positions, normals, texcoords;  // object space; normals, texcoords may be empty
     std::vector<glm::vec4> colors;                      // empty without COLOR_0
   };
+  // Adds the weighted POSITION and NORMAL deltas of the primitive's
+  // morph targets to `v`; returns whether any weight was nonzero.
+  bool applyMorphTargets(const json& prim, const std::string& e, const std::vector<double>& weights,
+                         VertexData& v) const;
+  // Moves `v`'s positions and normals into world space by the skin's
+  // blended joint matrices (JOINTS_n, WEIGHTS_n); returns whether most
+  // vertices' skin matrices mirror.
+  bool applySkin(const json& prim, const std::string& e, size_t skin, VertexData& v);
   uint32_t materialOf(const json& prim);  // adds the default material when the primitive names none
   int64_t texCoordSetOf(const json& prim) const;
   VertexData readVertexData(const json& prim, const std::string& e, Instance& inst) const;
@@ -108,7 +131,13 @@ class SceneBuilder {
   const json& doc_;
   const tinygltf::Model& model_;
   const MemoryBudget& budget_;
+  const PoseRequest pose_;
   Scene scene_;
+  std::vector<int64_t> parent_;  // per node, -1 for roots
+  std::vector<Animation> animations_;
+  std::vector<NodePose> nodePose_;                    // per node, at pose_
+  std::vector<std::optional<glm::dmat4>> world_;      // per node, worldOf's memo
+  std::map<size_t, std::vector<glm::dmat4>> joints_;  // per skin, jointMatrices' memo
   int64_t defaultMaterial_ = -1;
   std::map<int64_t, std::vector<uint8_t>> decodedViews_;  // by bufferView
   std::map<int64_t, DracoAttribute> dracoAccessors_;      // by accessor; the primitive being added
@@ -320,27 +349,202 @@ std::vector<uint32_t> SceneBuilder::readIndices(int64_t index, const std::string
 
 glm::dmat4 SceneBuilder::localMatrix(size_t node) const {
   const json& n = array("nodes")[node];
-  if (n.contains("matrix")) {
+  if (n.contains("matrix")) {  // loadAnimations refuses channels on such nodes
     std::vector<double> m = n.at("matrix").get<std::vector<double>>();
     return glm::make_mat4(m.data());  // glTF matrices are column-major, as GLM's
   }
+  const NodePose& pose = nodePose_[node];
   glm::dmat4 result(1.0);
-  if (n.contains("translation")) {
+  if (pose.translation) {
+    result = glm::translate(result, *pose.translation);
+  } else if (n.contains("translation")) {
     const auto t = n.at("translation").get<std::vector<double>>();
     result = glm::translate(result, glm::dvec3(t[0], t[1], t[2]));
   }
-  if (n.contains("rotation")) {
+  if (pose.rotation) {
+    result = result * glm::mat4_cast(*pose.rotation);  // sampleAt normalised it
+  } else if (n.contains("rotation")) {
     const auto r = n.at("rotation").get<std::vector<double>>();
     glm::dquat q(r[3], r[0], r[1], r[2]);  // glTF stores (x, y, z, w)
     const double length = glm::length(q);
     if (!(length > 0.0)) fail("node " + std::to_string(node), "\"rotation\" is a zero quaternion");
     result = result * glm::mat4_cast(q / length);  // exporters round: renormalise
   }
-  if (n.contains("scale")) {
+  if (pose.scale) {
+    result = glm::scale(result, *pose.scale);
+  } else if (n.contains("scale")) {
     const auto s = n.at("scale").get<std::vector<double>>();
     result = glm::scale(result, glm::dvec3(s[0], s[1], s[2]));
   }
   return result;
+}
+
+void SceneBuilder::loadAnimations() {
+  const json& animations = array("animations");
+  const json& nodes = array("nodes");
+  for (size_t a = 0; a < animations.size(); ++a) {
+    const json& aj = animations[a];
+    const std::string e = "animation " + std::to_string(a);
+    Animation anim;
+    anim.name = get<std::string>(aj, "name", "");
+    const json& samplers = aj.at("samplers");
+    std::vector<size_t> outputComponents(samplers.size());
+    for (size_t k = 0; k < samplers.size(); ++k) {
+      const json& sj = samplers[k];
+      const std::string se = e + " sampler " + std::to_string(k);
+      AnimationSampler sampler;
+      sampler.interpolation = *parseInterpolation(get<std::string>(sj, "interpolation", "LINEAR"));
+      size_t components = 0;
+      sampler.input = readAccessor(sj.at("input").get<int64_t>(), se + " input", {"SCALAR"}, &components);
+      sampler.output = readAccessor(sj.at("output").get<int64_t>(), se + " output",
+                                    {"SCALAR", "VEC3", "VEC4"}, &outputComponents[k]);
+      anim.samplers.push_back(std::move(sampler));
+    }
+    // Each channel fixes its sampler's value width: 3 (translation, scale),
+    // 4 (rotation) or the target node's morph target count (weights).
+    std::vector<size_t> width(samplers.size(), 0);
+    const json& channels = aj.at("channels");
+    for (size_t k = 0; k < channels.size(); ++k) {
+      const json& cj = channels[k];
+      const std::string ce = e + " channel " + std::to_string(k);
+      const json& target = cj.at("target");
+      if (!target.contains("node")) continue;  // an extension's target: nothing to play
+      AnimationChannel channel;
+      channel.sampler = cj.at("sampler").get<uint32_t>();
+      channel.node = target.at("node").get<uint32_t>();
+      channel.property = *parseAnimatedProperty(target.at("path").get<std::string>());
+      const json& node = nodes[channel.node];
+      if (node.contains("matrix"))
+        fail(ce, "targets node " + std::to_string(channel.node) +
+                     ", which has a \"matrix\" (glTF animates translation, rotation and scale only)");
+      size_t w = 0, accessorComponents = 1;
+      const char* type = "SCALAR";
+      switch (channel.property) {
+        case AnimatedProperty::Translation:
+        case AnimatedProperty::Scale:
+          w = accessorComponents = 3;
+          type = "VEC3";
+          break;
+        case AnimatedProperty::Rotation:
+          w = accessorComponents = 4;
+          type = "VEC4";
+          break;
+        case AnimatedProperty::Weights: {
+          size_t targets = 0;
+          if (node.contains("mesh"))
+            for (const json& prim : array("meshes")[node.at("mesh").get<size_t>()].at("primitives"))
+              targets = std::max(targets, prim.contains("targets") ? prim.at("targets").size() : size_t(0));
+          if (targets == 0)
+            fail(ce, "animates the weights of node " + std::to_string(channel.node) +
+                         ", whose mesh has no morph targets");
+          w = targets;
+          break;
+        }
+      }
+      const std::string se = e + " sampler " + std::to_string(channel.sampler);
+      if (outputComponents[channel.sampler] != accessorComponents)
+        fail(ce, "path \"" + target.at("path").get<std::string>() + "\" needs a " + type + " output; " + se +
+                     "'s has " + std::to_string(outputComponents[channel.sampler]) + " components");
+      if (width[channel.sampler] != 0 && width[channel.sampler] != w)
+        fail(ce, se + " is shared by channels whose values have different sizes");
+      width[channel.sampler] = w;
+      anim.channels.push_back(channel);
+    }
+    for (size_t k = 0; k < anim.samplers.size(); ++k) {
+      AnimationSampler& sampler = anim.samplers[k];
+      sampler.width = width[k] ? width[k] : outputComponents[k];
+      const std::string se = e + " sampler " + std::to_string(k);
+      checkAnimationSampler(sampler, path_, se);
+    }
+    for (const AnimationChannel& c : anim.channels) {
+      if (c.property != AnimatedProperty::Rotation) continue;
+      const AnimationSampler& sampler = anim.samplers[c.sampler];
+      const bool cubic = sampler.interpolation == Interpolation::CubicSpline;
+      for (size_t key = 0; key < sampler.input.size(); ++key) {
+        const double* q = sampler.output.data() + (cubic ? 3 * key + 1 : key) * 4;
+        if (q[0] == 0.0 && q[1] == 0.0 && q[2] == 0.0 && q[3] == 0.0)
+          fail(e + " sampler " + std::to_string(c.sampler),
+               "output key " + std::to_string(key) + " is a zero quaternion (no rotation)");
+      }
+    }
+    AnimationSummary summary = anim.summary();
+    summary.channels = uint32_t(channels.size());
+    scene_.animations.push_back(summary);
+    animations_.push_back(std::move(anim));
+  }
+  scene_.pose = pose_;
+  if (pose_.animation >= 0 && size_t(pose_.animation) >= animations_.size())
+    throw InputError("command line", "--animation",
+                     "animation " + std::to_string(pose_.animation) + " does not exist: " + path_ + " has " +
+                         std::to_string(animations_.size()) + " animation" +
+                         (animations_.size() == 1 ? "" : "s"));
+  nodePose_ = poseAt(animations_, pose_, nodes.size());
+  world_.assign(nodes.size(), std::nullopt);
+}
+
+const glm::dmat4& SceneBuilder::worldOf(size_t node) {
+  // Up the parent chain to the first node already known, then down.
+  std::vector<size_t> chain;
+  for (int64_t i = int64_t(node); i >= 0 && !world_[size_t(i)]; i = parent_[size_t(i)])
+    chain.push_back(size_t(i));
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+    const int64_t p = parent_[*it];
+    world_[*it] = (p >= 0 ? *world_[size_t(p)] : glm::dmat4(1.0)) * localMatrix(*it);
+  }
+  return *world_[node];
+}
+
+const std::vector<glm::dmat4>& SceneBuilder::jointMatrices(size_t skin) {
+  const auto known = joints_.find(skin);
+  if (known != joints_.end()) return known->second;
+  const json& s = array("skins")[skin];
+  const std::string e = "skin " + std::to_string(skin);
+  const json& joints = s.at("joints");
+  std::vector<double> inverseBind;
+  if (s.contains("inverseBindMatrices")) {
+    size_t components = 0;
+    const int64_t accessor = s.at("inverseBindMatrices").get<int64_t>();
+    inverseBind = readAccessor(accessor, e + " inverseBindMatrices", {"MAT4"}, &components);
+    if (inverseBind.size() / 16 < joints.size())
+      fail(e, "inverseBindMatrices (accessor " + std::to_string(accessor) + ") has " +
+                  std::to_string(inverseBind.size() / 16) + " matrices for " + std::to_string(joints.size()) +
+                  " joints");
+  }
+  std::vector<glm::dmat4> out;
+  for (size_t j = 0; j < joints.size(); ++j) {
+    const glm::dmat4 ibm =
+        inverseBind.empty() ? glm::dmat4(1.0) : glm::make_mat4(inverseBind.data() + 16 * j);
+    const glm::dmat4 m = worldOf(joints[j].get<size_t>()) * ibm;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!std::isfinite(m[c][r])) fail(e, "the matrix of joint " + std::to_string(j) + " is not finite");
+    out.push_back(m);
+  }
+  return joints_[skin] = std::move(out);
+}
+
+std::vector<double> SceneBuilder::morphWeights(size_t node, size_t mesh, size_t targets) const {
+  const std::optional<std::vector<double>>& animated = nodePose_[node].weights;
+  const json& n = array("nodes")[node];
+  const json& m = array("meshes")[mesh];
+  std::vector<double> w;
+  std::string from;
+  if (animated) {
+    w = *animated;
+    from = "the animated weights of node " + std::to_string(node);
+  } else if (n.contains("weights")) {
+    w = n.at("weights").get<std::vector<double>>();
+    from = "node " + std::to_string(node) + " \"weights\"";
+  } else if (m.contains("weights")) {
+    w = m.at("weights").get<std::vector<double>>();
+    from = "mesh " + std::to_string(mesh) + " \"weights\"";
+  } else {
+    return std::vector<double>(targets, 0.0);
+  }
+  if (w.size() != targets)
+    fail("mesh " + std::to_string(mesh), from + " has " + std::to_string(w.size()) + " entries for " +
+                                             std::to_string(targets) + " morph targets");
+  return w;
 }
 
 void SceneBuilder::checkNodeGraph(std::vector<int64_t>& parent) const {
@@ -555,8 +759,20 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
   const bool draco =
       prim.contains("extensions") && prim.at("extensions").contains("KHR_draco_mesh_compression");
   if (draco) decodeDraco(prim, e);
-  const VertexData vertices = readVertexData(prim, e, inst);
-  appendVertices(inst, vertices, world, e);
+  VertexData vertices = readVertexData(prim, e, inst);
+  if (prim.contains("targets"))
+    inst.morphed = applyMorphTargets(prim, e, morphWeights(node, mesh, prim.at("targets").size()), vertices);
+  const json& n = array("nodes")[node];
+  if (n.contains("skin") && attributes.contains("JOINTS_0") && attributes.contains("WEIGHTS_0")) {
+    // The skin places the vertices in world space; the node's own
+    // transform is ignored (glTF 2.0 §3.7.3.3).
+    inst.skinned = true;
+    inst.worldFromObject = glm::dmat4(1.0);
+    inst.mirrored = applySkin(prim, e, n.at("skin").get<size_t>(), vertices);
+    appendVertices(inst, vertices, glm::dmat4(1.0), e);
+  } else {
+    appendVertices(inst, vertices, world, e);
+  }
   appendTriangles(inst, prim, e);
   dracoAccessors_.clear();
   scene_.instances.push_back(inst);
@@ -641,7 +857,7 @@ void SceneBuilder::appendVertices(Instance& inst, const VertexData& v, const glm
   // normals on the same side for mirroring transforms.
   const glm::dmat3 m3(world);
   const glm::dmat3 cofactor(glm::cross(m3[1], m3[2]), glm::cross(m3[2], m3[0]), glm::cross(m3[0], m3[1]));
-  const double sign = inst.mirrored ? -1.0 : 1.0;
+  const double sign = glm::determinant(m3) < 0.0 ? -1.0 : 1.0;
   const std::vector<double>& pos = v.positions;
   const std::vector<double>& nrm = v.normals;
   const std::vector<double>& uv = v.texcoords;
@@ -669,6 +885,100 @@ void SceneBuilder::appendVertices(Instance& inst, const VertexData& v, const glm
       scene_.colors.push_back(inst.hasColors ? v.colors[i] : glm::vec4(1.0f));
   }
   inst.vertexCount = uint32_t(v.count);
+}
+
+bool SceneBuilder::applyMorphTargets(const json& prim, const std::string& e,
+                                     const std::vector<double>& weights, VertexData& v) const {
+  const json& targets = prim.at("targets");
+  bool any = false;
+  for (size_t t = 0; t < targets.size(); ++t) {
+    if (weights[t] == 0.0) continue;
+    any = true;
+    const std::string te = e + " target " + std::to_string(t);
+    for (const char* attribute : {"POSITION", "NORMAL"}) {
+      std::vector<double>& base = attribute[0] == 'P' ? v.positions : v.normals;
+      if (!targets[t].contains(attribute) || base.empty()) continue;  // no NORMAL to move: face normals
+      size_t components = 0;
+      const std::vector<double> delta =
+          readAccessor(targets[t].at(attribute).get<int64_t>(), te + " " + attribute, {"VEC3"}, &components);
+      if (delta.size() != base.size())
+        fail(te, std::string(attribute) + " has " + std::to_string(delta.size() / 3) +
+                     " elements, the primitive " + std::to_string(v.count) + " vertices");
+      for (size_t i = 0; i < base.size(); ++i) base[i] += weights[t] * delta[i];
+    }
+  }
+  return any;
+}
+
+bool SceneBuilder::applySkin(const json& prim, const std::string& e, size_t skin, VertexData& v) {
+  const std::vector<glm::dmat4>& joints = jointMatrices(skin);
+  const json& attributes = prim.at("attributes");
+  // JOINTS_0/WEIGHTS_0, JOINTS_1/WEIGHTS_1, ...: four influences per set,
+  // read and checked first; then one blended matrix per vertex at a time.
+  struct Influences {
+    std::vector<double> joint, weight;
+    std::string weightElement;
+  };
+  std::vector<Influences> sets;
+  for (int set = 0;; ++set) {
+    const std::string jn = "JOINTS_" + std::to_string(set), wn = "WEIGHTS_" + std::to_string(set);
+    if (!attributes.contains(jn) || !attributes.contains(wn)) break;
+    const int64_t ja = attributes.at(jn).get<int64_t>(), wa = attributes.at(wn).get<int64_t>();
+    const std::string je = e + " " + jn + " (accessor " + std::to_string(ja) + ")";
+    const std::string we = e + " " + wn + " (accessor " + std::to_string(wa) + ")";
+    const int64_t jct = array("accessors")[size_t(ja)].at("componentType").get<int64_t>();
+    if (jct != 5121 && jct != 5123)
+      fail(je, "componentType " + std::to_string(jct) + " must be 5121 or 5123");
+    size_t components = 0;
+    Influences in{readAccessor(ja, e + " " + jn, {"VEC4"}, &components),
+                  readAccessor(wa, e + " " + wn, {"VEC4"}, &components), we};
+    if (in.joint.size() != 4 * v.count)
+      fail(je,
+           "has " + std::to_string(in.joint.size() / 4) + " elements, POSITION " + std::to_string(v.count));
+    if (in.weight.size() != 4 * v.count)
+      fail(we,
+           "has " + std::to_string(in.weight.size() / 4) + " elements, POSITION " + std::to_string(v.count));
+    for (size_t i = 0; i < 4 * v.count; ++i) {
+      if (in.joint[i] >= double(joints.size()))
+        fail(je, "vertex " + std::to_string(i / 4) + " names joint " + std::to_string(uint64_t(in.joint[i])) +
+                     "; skin " + std::to_string(skin) + " has " + std::to_string(joints.size()) + " joints");
+      if (in.weight[i] < 0.0) fail(we, "vertex " + std::to_string(i / 4) + " has a negative weight");
+    }
+    sets.push_back(std::move(in));
+  }
+  size_t mirroring = 0;
+  for (size_t i = 0; i < v.count; ++i) {
+    glm::dmat4 m(0.0);
+    double weightSum = 0.0;
+    for (const Influences& in : sets)
+      for (size_t k = 4 * i; k < 4 * i + 4; ++k)
+        if (in.weight[k] != 0.0) {
+          m += in.weight[k] * joints[size_t(in.joint[k])];
+          weightSum += in.weight[k];
+        }
+    // Weights should sum to 1; exporters round (and 8-bit weights cannot
+    // say 1/3): normalise.
+    if (!(weightSum > 0.0))
+      fail(sets.front().weightElement, "vertex " + std::to_string(i) + " has weights summing to 0");
+    m /= weightSum;
+    const glm::dvec3 p =
+        glm::dvec3(m * glm::dvec4(v.positions[3 * i], v.positions[3 * i + 1], v.positions[3 * i + 2], 1.0));
+    std::copy_n(&p.x, 3, &v.positions[3 * i]);
+    const glm::dmat3 m3(m);
+    const double det = glm::determinant(m3);
+    mirroring += det < 0.0;
+    if (!v.normals.empty()) {
+      // The inverse transpose, as the cofactor matrix (defined when m3 is
+      // singular; its sign kept by det), renormalised.
+      const glm::dmat3 cofactor(glm::cross(m3[1], m3[2]), glm::cross(m3[2], m3[0]), glm::cross(m3[0], m3[1]));
+      glm::dvec3 n = (det < 0.0 ? -1.0 : 1.0) *
+                     (cofactor * glm::dvec3(v.normals[3 * i], v.normals[3 * i + 1], v.normals[3 * i + 2]));
+      const double len = glm::length(n);
+      if (len > 0.0 && std::isfinite(len)) n /= len;
+      std::copy_n(&n.x, 3, &v.normals[3 * i]);
+    }
+  }
+  return 2 * mirroring > v.count;
 }
 
 // Triangulates (SPEC §1) the primitive's indices, or its vertices in order
@@ -966,16 +1276,14 @@ void SceneBuilder::noteIgnoredFeatures() {
   }
   for (const json& mesh : array("meshes"))
     for (const json& prim : mesh.at("primitives")) {
-      if (prim.contains("targets")) noteIgnored("morph targets", "primitive");
-      for (auto it = prim.at("attributes").begin(); it != prim.at("attributes").end(); ++it)
-        if (it.key().rfind("JOINTS_", 0) == 0) {
-          noteIgnored("skinning attributes (JOINTS_n/WEIGHTS_n)", "primitive");
-          break;
-        }
+      // Morph targets move POSITION and NORMAL (TANGENT is not read).
+      if (!prim.contains("targets")) continue;
+      bool other = false;
+      for (const json& target : prim.at("targets"))
+        for (auto it = target.begin(); it != target.end(); ++it)
+          other = other || it.key().rfind("TEXCOORD_", 0) == 0 || it.key().rfind("COLOR_", 0) == 0;
+      if (other) noteIgnored("morph target TEXCOORD_n/COLOR_n deltas", "primitive");
     }
-  for (const json& n : array("nodes"))
-    if (n.contains("skin")) noteIgnored("skin", "node");
-  for (size_t i = 0; i < array("animations").size(); ++i) noteIgnored("animation", "");
   std::vector<std::string> path;
   noteIgnoredExtensions(doc_, path);
 }
@@ -1023,9 +1331,9 @@ Scene SceneBuilder::build() {
   decodeMeshoptViews();
   loadTextures();
   loadMaterials();
-  std::vector<int64_t> parent;
-  checkNodeGraph(parent);
-  const std::vector<size_t> roots = rootNodes(parent);
+  checkNodeGraph(parent_);
+  loadAnimations();
+  const std::vector<size_t> roots = rootNodes(parent_);
   reserveFlattenedScene(roots);
   walk(roots);
   noteIgnoredFeatures();
@@ -1035,8 +1343,8 @@ Scene SceneBuilder::build() {
 }  // namespace
 
 Scene buildScene(const std::string& path, const nlohmann::json& doc, const tinygltf::Model& model,
-                 const MemoryBudget& budget) {
-  return SceneBuilder(path, doc, model, budget).build();
+                 const MemoryBudget& budget, const PoseRequest& pose) {
+  return SceneBuilder(path, doc, model, budget, pose).build();
 }
 
 }  // namespace rastray

@@ -21,7 +21,9 @@ namespace rastray {
 // factors outside [0, 1], images that did not decode, and a flattened
 // scene (meshes times the nodes instancing them) of 2^32 vertices or
 // triangles or beyond `budget`, counted before anything is allocated.
+// The scene is flattened at `pose` (common/gltf/animation.h): animation
+// data is checked whether or not it plays.
 Scene buildScene(const std::string& path, const nlohmann::json& doc, const tinygltf::Model& model,
-                 const MemoryBudget& budget);
+                 const MemoryBudget& budget, const PoseRequest& pose = {});
 
 }  // namespace rastray

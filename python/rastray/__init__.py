@@ -108,7 +108,7 @@ class Scene:
     def info(self, **camera_options):
         """The facts ``rastray info --json`` prints (schema rastray.info), as
         a dict; camera options (camera, eye, target, up, yfov, znear, zfar,
-        size) choose the camera it describes."""
+        size) choose the camera it describes, time and animation the frame."""
         return self._core.info_json(_args(camera_options))
 
     @property

@@ -51,6 +51,8 @@ const std::vector<Expected> kExpected = {
     {"--znear", kAllRenderers, OptionCondition::Always, {"0.1"}},
     {"--zfar", kAllRenderers, OptionCondition::Always, {"100"}},
     {"--size", kAllRenderers, OptionCondition::Always, {"8", "6"}},
+    {"--time", kAllRenderers, OptionCondition::Always, {"0.5"}},
+    {"--animation", kAllRenderers, OptionCondition::Always, {"0"}},  // value: see valueFor
     {"--spp", kAllRenderers, OptionCondition::Always, {"4"}},
     {"--exposure", kAllRenderers, OptionCondition::Always, {"1.5"}},
     {"--threads", kAllRenderers, OptionCondition::Always, {"1"}},
@@ -90,6 +92,8 @@ Args valueFor(const std::string& name, RendererKind kind) {
   Args args = {name};
   if (name == "--shadows") {
     args.push_back(kind == RendererKind::Raster ? "none" : "rays");
+  } else if (name == "--animation") {
+    args = {"--time", "0.5", "--animation", "0"};  // it chooses what --time plays
   } else {
     const Args& v = expected(name).value;
     args.insert(args.end(), v.begin(), v.end());
@@ -279,6 +283,23 @@ TEST(RenderOptions, AllRenderersAcceptWhatAppliesToOne) {
   error = finishWith({"--halo"}, false);
   ASSERT_TRUE(error);
   EXPECT_EQ(error->element(), "--halo");
+}
+
+// --animation chooses what --time plays: alone it would do nothing.
+TEST(RenderOptions, AnimationNeedsTime) {
+  const auto error = finishWith({"--animation", "1"}, false);
+  ASSERT_TRUE(error);
+  EXPECT_EQ(std::string(error->what()),
+            "command line: --animation: chooses what --time plays: give --time too");
+  RenderSettings s;
+  ASSERT_FALSE(finishWith({"--time", "1.5", "--animation", "all"}, false, &s));
+  EXPECT_EQ(s.pose.time, 1.5);
+  EXPECT_EQ(s.pose.animation, -1);
+  ASSERT_FALSE(finishWith({"--time", "-2", "--animation", "3"}, false, &s));
+  EXPECT_EQ(s.pose.time, -2.0);
+  EXPECT_EQ(s.pose.animation, 3);
+  EXPECT_TRUE(finishWith({"--time", "nan"}, false));
+  EXPECT_TRUE(finishWith({"--time", "inf"}, false));
 }
 
 // Through the real binary: refused before the scene is read, exit 2 and

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import rastray
-from conftest import run_cli, scene_path
+from conftest import cli_json, run_cli, scene_path
 
 RENDERERS = ["raster", "raytrace", "hybrid"]
 
@@ -91,3 +91,26 @@ def test_save_writes_what_read_exr_reads(tmp_path, cornell):
     frame.save(tmp_path / "f.exr", float_color=True)
     back = rastray.read_exr(tmp_path / "f.exr")
     assert same_bits(back.color, frame.color) and same_bits(back.triangle, frame.triangle)
+
+
+SKIN = "/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf"
+
+
+@pytest.mark.skipif(not __import__("os").path.exists(SKIN), reason="assimp-testmodels is not installed")
+def test_time_poses_the_scene_as_the_command_line_does(tmp_path):
+    # time= comes through the option table: a loaded scene is posed again
+    # for another time, and the picture is the command line's at --time.
+    scene = rastray.load(SKIN)
+    camera = dict(eye=(0, 1, 4), target=(0, 1, 0), size=(48, 36))
+    rest = rastray.render(scene, **camera)
+    bent = rastray.render(scene, time=2, **camera)
+    assert bent.args[bent.args.index("--time") + 1] == "2"
+    assert not same_bits(rest.instance, bent.instance)
+    out = tmp_path / "cli.exr"
+    run_cli("render", SKIN, "-o", out, "--float", *bent.args)
+    assert same_bits(bent.color, rastray.read_exr(out).color)
+    assert same_bits(rastray.render(scene, time=2, **camera).color, bent.color)
+    # info at a time is the command line's info --time.
+    info = scene.info(time=2)
+    assert info["bounds"] == cli_json("info", SKIN, "--json", "--time", "2")["bounds"]
+    assert info["bounds"] != scene.info()["bounds"]

@@ -26,7 +26,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 VALID = os.path.join(HERE, "valid")
 
 BYTE, UBYTE, SHORT, USHORT, UINT, FLOAT = 5120, 5121, 5122, 5123, 5125, 5126
-COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
+COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 FORMAT = {BYTE: "b", UBYTE: "B", SHORT: "h", USHORT: "H", UINT: "I", FLOAT: "f"}
 TRIANGLES, STRIP, FAN = 4, 5, 6
 ASSET = {"version": "2.0", "generator": "rastray tests/data/malformed/generate.py"}
@@ -129,6 +129,37 @@ def cube_doc(index_values):
     attributes = {"POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv}
     mesh = {"primitives": [{"attributes": attributes, "indices": idx}]}
     return b.gltf([mesh], [{"mesh": 0}], scenes=[{"nodes": [0]}], scene=0)
+
+
+def animated_quad(times, values, interpolation="LINEAR", path="translation", type_="VEC3"):
+    """quad_doc's quad with one animation channel on node 0. Accessors:
+    0 POSITION, 1 NORMAL, 2 indices, 3 input times, 4 output values."""
+    b = Builder()
+    pos = b.positions(QUAD)
+    nrm = b.vec3([(0, 0, 1)] * 4)
+    idx = b.indices([0, 1, 2, 0, 2, 3])
+    times_accessor = b.accessor(times, FLOAT, "SCALAR")
+    values_accessor = b.accessor(values, FLOAT, type_)
+    mesh = {"primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": idx}]}
+    animation = {"samplers": [{"input": times_accessor, "output": values_accessor,
+                               "interpolation": interpolation}],
+                 "channels": [{"sampler": 0, "target": {"node": 0, "path": path}}]}
+    return b.gltf([mesh], [{"mesh": 0}], scenes=[{"nodes": [0]}], scene=0, animations=[animation])
+
+
+def skinned_quad(joints):
+    """The quad skinned to node 1, with the skin's joint list `joints`.
+    Accessors: 0 POSITION, 1 indices, 2 JOINTS_0 (vertex 3 names joint 1),
+    3 WEIGHTS_0."""
+    b = Builder()
+    pos = b.positions(QUAD)
+    idx = b.indices([0, 1, 2, 0, 2, 3])
+    jnt = b.accessor([0, 0, 0, 0] * 3 + [1, 0, 0, 0], USHORT, "VEC4")
+    wgt = b.accessor([1, 0, 0, 0] * 4, FLOAT, "VEC4")
+    mesh = {"primitives": [{"attributes": {"POSITION": pos, "JOINTS_0": jnt, "WEIGHTS_0": wgt},
+                            "indices": idx}]}
+    return b.gltf([mesh], [{"mesh": 0, "skin": 0}, {}, {}], scenes=[{"nodes": [0, 1, 2]}], scene=0,
+                  skins=[{"joints": joints}])
 
 
 def text(doc):
@@ -303,6 +334,25 @@ def malformed():
     files["sparse-index-out-of-range.gltf"] = text(
         b.gltf([{"primitives": [{"attributes": {"POSITION": pos}}]}], [{"mesh": 0}],
                scenes=[{"nodes": [0]}]))
+
+    # Animations, skins, morph targets.
+    files["animation-times-not-increasing.gltf"] = text(
+        animated_quad([0, 1, 1], [0, 0, 0, 1, 0, 0, 2, 0, 0]))
+    files["animation-output-too-short.gltf"] = text(animated_quad([0, 1, 2], [0, 0, 0, 1, 0, 0]))
+    files["animation-keyframe-nan.gltf"] = text(animated_quad([0, 1], [0, 0, 0, float("nan"), 0, 0]))
+    files["animation-interpolation-bad.gltf"] = text(
+        animated_quad([0, 1], [0, 0, 0, 1, 0, 0], interpolation="SMOOTH"))
+    d = animated_quad([0, 1], [0, 0, 0, 1, 0, 0])
+    d["animations"][0]["channels"][0]["target"]["node"] = 5
+    files["animation-channel-node-missing.gltf"] = text(d)
+    files["animation-rotation-zero-key.gltf"] = text(
+        animated_quad([0, 1], [0, 0, 0, 1, 0, 0, 0, 0], path="rotation", type_="VEC4"))
+    files["skin-no-joints.gltf"] = text(skinned_quad([]))
+    files["skin-joint-out-of-range.gltf"] = text(skinned_quad([1]))
+    d = quad_doc()
+    d["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": 1}]
+    d["nodes"][0]["weights"] = [0.5, 0.5]
+    files["morph-weights-count.gltf"] = text(d)
 
     # Node graph and scenes.
     d = quad_doc()
@@ -562,6 +612,38 @@ def valid():
     files["trs-vs-matrix.gltf"] = text(b.gltf(
         [mesh], [{"mesh": 0, "translation": list(t), "rotation": [0.5, 0.5, 0.5, 0.5], "scale": list(s)},
                  {"mesh": 0, "matrix": matrix}], scenes=[{"nodes": [0, 1]}]))
+
+    # Every kind of animation data in one file (a fuzz seed; loaded at
+    # several times by tests/common/animation_test.cpp): a quad skinned
+    # to two joints (node 1, its child node 2), with one morph target;
+    # STEP translation of joint 0, LINEAR rotation of joint 1, CUBICSPLINE
+    # weights of the mesh node.
+    b = Builder()
+    pos = b.positions(QUAD)
+    nrm = b.vec3([(0, 0, 1)] * 4)
+    idx = b.indices([0, 1, 2, 0, 2, 3])
+    jnt = b.accessor([0, 1, 0, 0] * 4, USHORT, "VEC4")
+    wgt = b.accessor([1, 0, 0, 0, 1, 0, 0, 0, 0.5, 0.5, 0, 0, 0, 1, 0, 0], FLOAT, "VEC4")
+    lift = b.vec3([(0, 0, 1)] * 4)
+    ibm = b.accessor([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,
+                      1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1], FLOAT, "MAT4")
+    times = b.accessor([0, 1, 2], FLOAT, "SCALAR")
+    steps = b.vec3([(0, 0, 0), (0.5, 0, 0), (0, 0.5, 0)])
+    turns = b.accessor([0, 0, 0, 1, 0, 0, 0.70710678, 0.70710678, 0, 0, 1, 0], FLOAT, "VEC4")
+    weights = b.accessor([0, 0, 0, 0, 1, 0, 0, 0.5, 0], FLOAT, "SCALAR")  # (in, value, out) per key
+    mesh = {"primitives": [{"attributes": {"POSITION": pos, "NORMAL": nrm, "JOINTS_0": jnt, "WEIGHTS_0": wgt},
+                            "indices": idx, "targets": [{"POSITION": lift}]}], "weights": [0]}
+    animations = [{"name": "all three", "samplers": [
+        {"input": times, "output": steps, "interpolation": "STEP"},
+        {"input": times, "output": turns},
+        {"input": times, "output": weights, "interpolation": "CUBICSPLINE"}], "channels": [
+        {"sampler": 0, "target": {"node": 1, "path": "translation"}},
+        {"sampler": 1, "target": {"node": 2, "path": "rotation"}},
+        {"sampler": 2, "target": {"node": 0, "path": "weights"}}]}]
+    files["animated.gltf"] = text(b.gltf(
+        [mesh], [{"mesh": 0, "skin": 0}, {"children": [2]}, {"translation": [0, 1, 0]}],
+        scenes=[{"nodes": [0, 1]}], skins=[{"joints": [1, 2], "inverseBindMatrices": ibm}],
+        animations=animations))
 
     # Three triangles: proper, collinear, repeated vertex.
     b = Builder()
