@@ -69,7 +69,7 @@ void hybridFrame(benchmark::State& state, const std::string& name) {
   const Loaded& l = load(name);
   RasterOptions ro;
   ro.spp = kSpp;
-  ro.shadows = ShadowMode::Rays;
+  ro.shadows = RasterShadows::Traced;
   RayOptions yo;
   yo.spp = kSpp;
   for (auto _ : state) {

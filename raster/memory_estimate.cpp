@@ -27,7 +27,7 @@ void addRasterFrameMemory(const Scene& scene, const RasterOptions& options, uint
   transient.add("setup vertex codes", mulSat(scene.positions.size(), kSetupVertexCodeBytes));
   transient.add("tile bins", mulSat(triangles, kBinBytesPerTriangle));
   transient.add("depth target", mulSat(samples, kDepthTargetSampleBytes));
-  if (options.shadows == ShadowMode::Map && !scene.lights.empty()) {
+  if (options.shadows == RasterShadows::Map && !scene.lights.empty()) {
     // Every face of every light's map stays until the frame ends; one
     // face's setups and a candidate mask exist while it is drawn.
     uint64_t faces = 0;

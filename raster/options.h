@@ -18,7 +18,11 @@ class RasterFrameBuffers;  // raster/frame_buffers.h
 // order: Less keeps the lower id, LEqual lets the higher win (depth.h).
 enum class DepthFunc { Less, LEqual };
 enum class TransparencyMode { Sorted, Peel, Exact };
-enum class ShadowMode { None, Map, Rays };  // Rays: hybrid only (traced shadow rays)
+// Where the camera pass learns whether a light reaches a point: nowhere
+// (all lit), its own shadow maps, or the LightVisibility its caller passes
+// (hybrid: the ray caster's shadow rays). The user's --shadows value is the
+// engine's ShadowMode (app/engine/render_options.h).
+enum class RasterShadows { None, Map, Traced };
 enum class ShadingRate { Pixel, Sample };
 
 struct RasterOptions {
@@ -30,7 +34,7 @@ struct RasterOptions {
   float polygonOffsetUnits = 0.0f;
   TransparencyMode transparency = TransparencyMode::Exact;
   int peelLayers = 8;  // Peel: layers kept per sample; those behind are dropped
-  ShadowMode shadows = ShadowMode::Map;
+  RasterShadows shadows = RasterShadows::Map;
   int shadowMapSize = 1024;         // texels per side (per cube face for point lights); docs/SHADOWS.md
   float shadowBiasConstant = 1.0f;  // in depth-format units, as glPolygonOffset's
   float shadowBiasSlope = 1.0f;     // × the occluder's max depth slope per texel

@@ -36,11 +36,11 @@ void checkOptions(const SceneAnalysis& analysis, const RasterOptions& options,
                   const LightVisibility* visibility) {
   if (options.transparency == TransparencyMode::Peel && options.peelLayers < 1)
     throw InputError("command line", "--transparency", "peel needs at least 1 layer");
-  if (options.shadows == ShadowMode::Rays && !visibility && analysis.shadows)
+  if (options.shadows == RasterShadows::Traced && !visibility && analysis.shadows)
     throw InputError(
         "command line", "--shadows",
         "rays needs the hybrid renderer (ray-traced visibility); the rasterizer offers map or none");
-  if (options.shadows == ShadowMode::Map && options.shadowMapSize < 1)
+  if (options.shadows == RasterShadows::Map && options.shadowMapSize < 1)
     throw InputError("command line", "--shadow-map-size", "must be at least 1");
 }
 
@@ -57,7 +57,7 @@ LightSetup prepareLights(const Scene& scene, const SceneAnalysis& analysis, cons
                          const RasterOptions& options, const LightVisibility* traced, RenderOutput* out) {
   LightSetup lights;
   const bool shadowsNeeded = analysis.shadows && !analysis.eyeLight;
-  if (shadowsNeeded && options.shadows == ShadowMode::Map) {
+  if (shadowsNeeded && options.shadows == RasterShadows::Map) {
     const auto start = Clock::now();
     // Unlit shader for MASK coverage and shadow transmittance while the maps render.
     const Shader mapShader(scene, analysis, camera, options.shading, nullptr, nullptr);
@@ -68,7 +68,7 @@ LightSetup prepareLights(const Scene& scene, const SceneAnalysis& analysis, cons
     out->timings.emplace_back("raster.shadow_maps", secondsSince(start));
     out->passesRun.push_back("shadow maps: " + std::to_string(lights.stats.maps) + " maps for " +
                              std::to_string(scene.lights.size()) + " lights");
-  } else if (shadowsNeeded && options.shadows == ShadowMode::Rays) {
+  } else if (shadowsNeeded && options.shadows == RasterShadows::Traced) {
     lights.visibility = traced;
     out->passesRun.push_back("shadows: traced shadow rays (hybrid)");
   } else if (shadowsNeeded) {

@@ -44,6 +44,20 @@ class ScratchCleaner : public ::testing::EmptyTestEventListener {
     else
       fs::remove_all(dir, ec);
   }
+  // A suite's set-up writes under the suite's name: removed when every test
+  // of it passed.
+  void OnTestSuiteEnd(const ::testing::TestSuite& suite) override {
+    std::string name = suite.name();
+    for (char& c : name)
+      if (c == '/') c = '_';
+    const fs::path dir = processDir() / name;
+    std::error_code ec;
+    if (!fs::exists(dir, ec)) return;
+    if (suite.Failed())
+      std::fprintf(stderr, "test files kept in %s\n", dir.c_str());
+    else
+      fs::remove_all(dir, ec);
+  }
   void OnTestProgramEnd(const ::testing::UnitTest&) override {
     std::error_code ec;
     fs::remove_all(processDir() / "program", ec);

@@ -30,7 +30,8 @@ CrossvalResult crossvalidate(const Scene& scene, const RenderSettings& settings,
   say("raytrace");
   r.raytrace = renderScene(scene, s, &memory);
   s.renderer = RendererKind::Hybrid;
-  s.raster.shadows = s.ray.shadows ? ShadowMode::Rays : ShadowMode::None;  // --shadows none: none anywhere
+  s.raster.shadows =
+      s.ray.shadows ? RasterShadows::Traced : RasterShadows::None;  // --shadows none: none anywhere
   say("hybrid");
   r.hybrid = renderScene(scene, s, &memory);
   r.camera = r.raytrace.camera;

@@ -285,8 +285,8 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
      "none", RASTRAY_PARSE(s.keptLights = parseLightList(v[0])),
      RASTRAY_FORMAT(return {formatLightList(s.keptLights)})},
     {"--cull", kAllRenderers, OptionCondition::Always, "Cull single-sided triangles: back, front or none", 1,
-     "back", RASTRAY_PARSE(s.raster.cull = pick("--cull", v[0], kCullModes)),
-     RASTRAY_FORMAT(return {nameOf(s.raster.cull, kCullModes)})},
+     "back", RASTRAY_PARSE(s.cull = pick("--cull", v[0], kCullModes)),
+     RASTRAY_FORMAT(return {nameOf(s.cull, kCullModes)})},
     {"--shadows", kAllRenderers, OptionCondition::Always,
      "map (shadow maps: raster, hybrid), rays (raytrace, hybrid) or none (every renderer); default map, "
      "rays for raytrace and hybrid",
@@ -521,7 +521,15 @@ ShadowMode RenderSettings::shadowModeFor(RendererKind kind) const {
   const ShadowMode traced = ray.shadows ? ShadowMode::Rays : ShadowMode::None;
   if (kind == RendererKind::Raytrace) return traced;
   if (kind == RendererKind::Hybrid && allRenderers) return traced;
-  return raster.shadows;
+  switch (raster.shadows) {
+    case RasterShadows::None:
+      return ShadowMode::None;
+    case RasterShadows::Map:
+      return ShadowMode::Map;
+    case RasterShadows::Traced:
+      return ShadowMode::Rays;
+  }
+  return ShadowMode::None;
 }
 
 bool RenderSettings::applies(const RenderOptionSpec& spec, RendererKind kind) const {
@@ -559,10 +567,14 @@ void RenderSettings::finish() {
     badOption("--shadows", "'" + nameOf(shadowMode, kShadowModes) + "' applies to " +
                                describeRenderers(shadowModeRenderers) + ", not to --renderer " +
                                toString(renderer));
-  raster.shadows = allRenderers && shadowMode == ShadowMode::Rays ? ShadowMode::Map : shadowMode;
+  raster.shadows = shadowMode == ShadowMode::None  ? RasterShadows::None
+                   : shadowMode == ShadowMode::Map ? RasterShadows::Map
+                   : allRenderers                  ? RasterShadows::Map  // the rasterizer alone has no rays
+                                                   : RasterShadows::Traced;
   ray.shadows = shadowMode != ShadowMode::None;
 
   raster.spp = spp;
+  raster.cull = cull;
   raster.shading = shading;
   raster.keepSamples = keepSamples;
   ray.spp = spp;

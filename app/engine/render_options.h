@@ -27,6 +27,10 @@
 namespace rastray {
 
 enum class RendererKind { Raster, Raytrace, Hybrid };
+// --shadows: how a renderer decides whether a light reaches a point. Map:
+// the rasterizer's shadow maps; Rays: shadow rays (the ray caster, and
+// hybrid through the rasterizer's RasterShadows::Traced); None: all lit.
+enum class ShadowMode { Map, Rays, None };
 const char* toString(RendererKind kind);
 // "raster", "raytrace", "hybrid"; nullopt for anything else.
 std::optional<RendererKind> parseRendererKind(const std::string& name);
@@ -94,6 +98,9 @@ struct RenderSettings {
   std::optional<glm::ivec2> debugPixel;
   RenderOrigin renderOrigin = RenderOrigin::Camera;
   PoseRequest pose;                               // --time, --animation: the pose the scene is loaded at
+  // --cull, for every renderer: finish() copies it into raster.cull; the ray
+  // caster takes it when its BVH is built (FrameRenderer, serve's shared casters).
+  CullMode cull = CullMode::None;
   std::optional<std::vector<size_t>> keptLights;  // --lights: nullopt keeps all; sorted, unique
   // --shadows as given; nullopt: map for the rasterizer, rays for the ray
   // caster and hybrid. finish() turns it into raster.shadows.

@@ -75,7 +75,7 @@ FrameRenderer::FrameRenderer(const Scene& scene, const RenderSettings& s, const 
     caster_ = std::move(sharedCaster);
   } else {
     const auto start = std::chrono::steady_clock::now();
-    caster_ = std::make_shared<RayCaster>(scene, analysis_, raster.cull);
+    caster_ = std::make_shared<RayCaster>(scene, analysis_, s.cull);
     bvhBuildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   // Bound to this camera and options in frame(), before each render.
@@ -115,7 +115,7 @@ RenderOutput FrameRenderer::renderFrame() {
     case RendererKind::Raytrace:
       return caster_->render();
     case RendererKind::Hybrid: {
-      const bool traced = raster_.shadows == ShadowMode::Rays;
+      const bool traced = raster_.shadows == RasterShadows::Traced;
       RenderOutput output =
           renderRaster(scene_, analysis_, camera_, raster_, caster_.get(), traced ? caster_.get() : nullptr);
       caster_->throwIfError();  // an Embree error in the rays the rasterizer's shading traced

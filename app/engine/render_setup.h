@@ -35,7 +35,7 @@ class FrameRenderer {
   // options the renderers run with (settings' own, plus keepSamples and
   // trace requests the caller set); they must outlive this object.
   // `sharedCaster`: a ray caster (its Embree BVH) already built for this
-  // scene and raster.cull, shared with other FrameRenderers (serve keeps one
+  // scene and settings.cull, shared with other FrameRenderers (serve keeps one
   // per prepared scene); it is bound to this camera and options before each
   // frame. Null: one is built here when the renderer needs it.
   FrameRenderer(const Scene& scene, const RenderSettings& settings, const RasterOptions& raster,

@@ -172,7 +172,7 @@ std::shared_ptr<PreparedFrame> SceneCache::frame(const std::string& path,
   const std::string casterKey = preparedKey(path, settings) +
                                 "\x1f"
                                 "cull " +
-                                std::to_string(int(settings.raster.cull));
+                                std::to_string(int(settings.cull));
   if (settings.renderer != RendererKind::Raster) {
     if (auto found = casters_.find(casterKey)) {
       if (found->scene == frame->scene) caster = found->caster;

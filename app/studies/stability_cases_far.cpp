@@ -117,6 +117,7 @@ std::vector<Row> runFar(const CaseContext& ctx, const std::string& name, const s
       row.metricName = "px off %";
       row.metric = 100.0 * fractionOff(r.image(), reference.image(), kOffThreshold);
       row.seconds = r.seconds();
+      row.measures["shadow samples checked"] = double(shadows.checked);
 
       // What this row asserts (mitigations off assert only "no NaN/Inf":
       // they exist to show the failure).

@@ -208,6 +208,8 @@ std::vector<Row> runTiling(const std::string& name, const CaseContext& ctx, cons
             "0 genuine mismatches; the rasterizer's owner of every sample is the exact top-left one; "
             "every interior sample covered exactly once in both renderers";
         row.pass = row.pass && mine.ownerDiffers() == 0 && mine.interiorWrong == 0 && ray.interiorWrong == 0;
+        row.measures["interior samples not covered once (this renderer)"] = double(mine.interiorWrong);
+        row.measures["interior samples not covered once (ray caster)"] = double(ray.interiorWrong);
         if (ctx.progress)
           ctx.progress(name + " " + row.variant + ": owner differs " + std::to_string(mine.ownerDiffers()) +
                        " (ray caster " + std::to_string(ray.innerDiffers) + " inside, " +
@@ -302,6 +304,10 @@ std::vector<Row> runGrazing(const std::string& name, bool textured, const CaseCo
           row.pass = row.pass && shadows.leaks == 0 &&
                      double(shadows.acne) <= 1e-3 * double(shadows.checked) && shadows.shadowed.size() == 2 &&
                      shadows.shadowed[1] >= 1000;
+          row.measures["shadow samples checked"] = double(shadows.checked);
+          row.measures["lights checked"] = double(shadows.shadowed.size());
+          row.measures["samples checked in the grazing light's shadow"] =
+              shadows.shadowed.size() == 2 ? double(shadows.shadowed[1]) : 0.0;
           addImage(row, writeValueImage(ctx, name, std::string(hybrid ? "hybrid" : "raster") + "-shadows.png",
                                         rendered.image().width, rendered.image().height, shadows.pixels,
                                         "0 fine, 1 acne, 2 leak, 3 edge",
@@ -316,6 +322,7 @@ std::vector<Row> runGrazing(const std::string& name, bool textured, const CaseCo
           row.metric = std::max(lr.maxLod, lt.maxLod);
           row.property += ", every texture LOD finite";
           row.pass = row.pass && lr.nonFinite == 0 && lt.nonFinite == 0;
+          row.measures["non-finite texture LODs"] = double(lr.nonFinite + lt.nonFinite);
           if (ctx.progress)
             ctx.progress(name + " " + row.variant + ": textured samples " + std::to_string(lr.samples) + "/" +
                          std::to_string(lt.samples) + ", non-finite LOD " + std::to_string(lr.nonFinite) +
@@ -405,6 +412,7 @@ std::vector<Row> runScale(const std::string& name, double scale, const CaseConte
                           std::to_string(shadows.edgeAcne + shadows.edgeLeaks) +
                           " within a map texel of an edge)";
           row.pass = row.pass && shadows.leaks == 0 && double(shadows.acne) <= 1e-3 * double(shadows.checked);
+          row.measures["shadow samples checked"] = double(shadows.checked);
         }
       }
       const std::string tag = v.label == "raster" || v.label == "raytrace" || !v.asserts ? v.label : "";

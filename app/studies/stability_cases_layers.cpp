@@ -174,6 +174,7 @@ std::vector<Row> runStack(const CaseContext& ctx, const std::string& name, const
     if (v.asserts) {
       row.property = property;
       row.pass = row.nanInf == 0 && row.metric <= tolerance && e.fewerLayers == 0;
+      row.measures["pixels with fewer layers than the stack"] = double(e.fewerLayers);
     }
     if (rows.empty() || !v.asserts)
       addImage(row, writeRenderImage(ctx, name, v.label.substr(0, v.label.find(' ')) + ".png", r.image(),
@@ -243,7 +244,7 @@ GltfScene clipScene() {
 
 std::vector<Row> crossvalRows(const CaseContext& ctx, const std::string& name, const std::string& path, int w,
                               int h, const std::string& property,
-                              const std::function<bool(const Row&, const RenderRun&)>& extra) {
+                              const std::function<bool(Row&, const RenderRun&)>& extra) {
   const CrossvalResult x = crossvalidateVariant(ctx, path, renderArgs(ctx, sizeArgs(w, h, 4)));
   std::vector<Row> rows;
   struct Entry {
@@ -362,7 +363,7 @@ void appendLayerCases(std::vector<Case>& cases) {
       true, clipScene, [](const CaseContext& ctx, const std::string& name, const std::string& path) {
         const int w = ctx.quick ? 80 : 160, h = ctx.quick ? 60 : 120;
         return crossvalRows(ctx, name, path, w, h, "no NaN/Inf, 0 genuine mismatches against the ray caster",
-                            [](const Row&, const RenderRun&) { return true; });
+                            [](Row&, const RenderRun&) { return true; });
       }));
   cases.push_back(makeCase(
       "degenerate", "clip",
@@ -373,10 +374,13 @@ void appendLayerCases(std::vector<Case>& cases) {
         return crossvalRows(
             ctx, name, path, w, h,
             "degenerate triangles cover nothing: no sample shows their IDs; raster.degenerate counts all 5",
-            [](const Row&, const RenderRun& run) {
+            [](Row& row, const RenderRun& run) {
               const auto& values = run.output.counters.values;
               const bool rasterizes = std::any_of(
                   values.begin(), values.end(), [](const auto& v) { return v.first == "raster.degenerate"; });
+              row.measures["samples showing a degenerate triangle"] = double(degenerateSamples(run.output));
+              if (rasterizes)
+                row.measures["raster.degenerate"] = double(run.output.counters.get("raster.degenerate"));
               return degenerateSamples(run.output) == 0 &&
                      (!rasterizes || run.output.counters.get("raster.degenerate") == kDegenerateCount);
             });

@@ -46,6 +46,7 @@ std::vector<Row> runLight(const CaseContext& ctx, const std::string& name, const
     row.metricName = "samples in shadow (checked)";
     row.metric = shadows.shadowed.empty() ? 0.0 : double(shadows.shadowed[0]);
     row.seconds = r.seconds();
+    row.measures["shadow samples checked"] = double(shadows.checked);
     // The shadows must be in the picture for the bounds to mean anything.
     row.property = "no NaN/Inf, >= 1000 checked samples in shadow";
     row.pass = row.nanInf == 0 && row.metric >= 1000.0 && shadows.acne >= 0;

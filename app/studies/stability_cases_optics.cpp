@@ -198,6 +198,8 @@ std::vector<Row> runBubble(const CaseContext& ctx, const std::string& name, cons
     row.metric = b.criticalOffset;
     row.property = "TIR band lies within one pixel of its analytic position";
     row.pass = row.nanInf == 0 && b.tirPixels > 0 && b.criticalOffset <= 1.0 && b.silhouetteOffset <= 1.0;
+    row.measures["TIR pixels"] = double(b.tirPixels);
+    row.measures["silhouette offset (px)"] = b.silhouetteOffset;
     char caption[256];
     std::snprintf(caption, sizeof caption,
                   "%s: TIR (1), refracting (0.5), wrong side of the analytic edges (2); r_c = %.2f px, "
@@ -270,7 +272,7 @@ double onAxisLowerBound() {
 // Largest angle (rad) between the axis and any ray of the centre pixel's
 // ray tree, and how many refraction rays it holds.
 std::pair<double, int> centreRayTree(const Rendered& r) {
-  RayCaster caster(r.scene, r.run.analysis, r.settings.raster.cull);
+  RayCaster caster(r.scene, r.run.analysis, r.settings.cull);
   caster.bind(r.run.camera, r.settings.ray);
   const glm::ivec2 centre(r.camera().width / 2, r.camera().height / 2);
   const glm::dvec3 axis = r.camera().forward();
@@ -301,10 +303,16 @@ std::vector<Row> runNested(const CaseContext& ctx, const std::string& name, cons
     // Float sums of weights that partition unity: a few ULPs above 1 at most.
     bool pass = row.nanInf == 0 && brightest <= 1.0f + 1e-5f;
     for (int k = 0; k < 3; ++k) pass = pass && centre[k] >= lower - 1e-5 && centre[k] <= 1.0 + 1e-5;
+    row.measures["brightest channel"] = double(brightest);
+    row.measures["on-axis lower bound"] = lower;
+    row.measures["centre pixel darkest channel"] = double(std::min({centre.r, centre.g, centre.b}));
+    row.measures["centre pixel brightest channel"] = double(std::max({centre.r, centre.g, centre.b}));
     char property[320];
     if (std::string(renderer) == "raytrace") {
       const auto [angle, refractions] = centreRayTree(r);
       pass = pass && angle < 1e-5 && refractions >= 4;
+      row.measures["centre ray deviation (rad)"] = angle;
+      row.measures["centre ray refractions"] = double(refractions);
       std::snprintf(property, sizeof property,
                     "no NaN/Inf, no pixel above the white furnace (max %.7f), centre pixel within [%.5f, 1], "
                     "centre rays undeviated (< 1e-5 rad: %.2g over %d refractions)",
@@ -385,6 +393,10 @@ std::vector<Row> runTrapped(const CaseContext& ctx, const std::string& name, con
           "black, no NaN/Inf";
       row.pass = row.nanInf == 0 && k.get("rays.reflection") == primaries * uint64_t(depth) &&
                  k.get("rays.refraction") == 0 && brightest == 0.0f;
+      row.measures["rays.reflection"] = double(k.get("rays.reflection"));
+      row.measures["primary rays x max depth"] = double(primaries * uint64_t(depth));
+      row.measures["rays.refraction"] = double(k.get("rays.refraction"));
+      row.measures["brightest channel"] = double(brightest);
       if (depth == 8)
         addImage(row, writeRenderImage(ctx, name, std::string(renderer) + ".png", r.image(),
                                        variant + ": black, nothing escapes"));

@@ -13,6 +13,11 @@
 #include "common/gltf/writer.h"
 #include "run_command.h"
 
+#include "tests/test_labels.h"
+
+// Every test here renders on 2 or more threads (the ThreadSanitizer stage runs them).
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 

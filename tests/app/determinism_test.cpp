@@ -10,6 +10,11 @@
 #include "app/engine/render_setup.h"
 #include "app/studies/stability_measure.h"
 
+#include "tests/test_labels.h"
+
+// Every test here renders on 2 or more threads (the ThreadSanitizer stage runs them).
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 

@@ -26,8 +26,6 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "app/engine/render_setup.h"
 #include "app/studies/stability_far_scene.h"
 #include "app/studies/stability_measure.h"
@@ -35,6 +33,7 @@
 #include "common/math_constants.h"
 #include "common/sampling.h"
 #include "common/surface.h"
+#include "tests/test_files.h"
 
 namespace rastray {
 namespace {
@@ -45,11 +44,7 @@ const glm::dvec3 kLightTravel = glm::normalize(glm::dvec3(0.6, -1.0, 0.4));
 constexpr float kIntensity = 3.0f;
 constexpr float kAlbedo = 0.8f;
 
-std::string tempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("rastray-offsets-" + std::to_string(getpid()) + "-" + name))
-      .string();
-}
+std::string tempPath(const std::string& name) { return test::scratchPath(name); }
 
 // A file removed when the test ends.
 struct TempScene {

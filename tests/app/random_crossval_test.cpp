@@ -14,6 +14,11 @@
 #include "random_scene.h"
 #include "run_command.h"
 
+#include "tests/test_labels.h"
+
+// Tests here render on 2 or more threads (the ThreadSanitizer stage runs them), except those marked quick.
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
@@ -91,6 +96,7 @@ TEST(RandomCrossval, SeedsThatFoundBugs) {
 }
 
 // The generator is deterministic: a seed names one scene.
+RASTRAY_TEST_LABELS_OF(RandomCrossval, SameSeedSameScene, "quick");
 TEST(RandomCrossval, SameSeedSameScene) {
   EXPECT_EQ(test::randomScene(42).toJson(), test::randomScene(42).toJson());
   EXPECT_NE(test::randomScene(42).toJson(), test::randomScene(43).toJson());

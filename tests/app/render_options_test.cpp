@@ -267,11 +267,11 @@ TEST(RenderOptions, AllRenderersAcceptWhatAppliesToOne) {
   }
   RenderSettings s;
   ASSERT_FALSE(finishWith({"--shadows", "rays", "--no-packets"}, false, &s));
-  EXPECT_EQ(s.raster.shadows, ShadowMode::Map);  // the rasterizer alone has no rays
+  EXPECT_EQ(s.raster.shadows, RasterShadows::Map);  // the rasterizer alone has no rays
   EXPECT_EQ(s.shadowModeFor(RendererKind::Hybrid), ShadowMode::Rays);
   EXPECT_FALSE(s.ray.packets);
   ASSERT_FALSE(finishWith({"--shadows", "none"}, false, &s));
-  EXPECT_EQ(s.raster.shadows, ShadowMode::None);
+  EXPECT_EQ(s.raster.shadows, RasterShadows::None);
   EXPECT_FALSE(s.ray.shadows);  // crossval: no renderer shadows
   EXPECT_EQ(s.shadowModeFor(RendererKind::Raytrace), ShadowMode::None);
   EXPECT_EQ(s.shadowModeFor(RendererKind::Hybrid), ShadowMode::None);

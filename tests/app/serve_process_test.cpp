@@ -19,6 +19,7 @@
 
 #include "run_command.h"
 #include "tests/test_files.h"
+#include "tests/test_labels.h"
 
 namespace rastray {
 namespace {
@@ -118,6 +119,7 @@ class ServeProcess {
 // on a pixel fills the explain panel and draws the ray tree. The mouse
 // events go through the page's own handlers (the ?selftest hook), which
 // reports in #selftest-result; --dump-dom prints it.
+RASTRAY_TEST_LABELS_OF(ServeBrowser, PageShowsTheImageAndExplainsAClickedPixel, "browser");
 TEST(ServeBrowser, PageShowsTheImageAndExplainsAClickedPixel) {
   const char* chromium = "/usr/bin/chromium";
   ASSERT_TRUE(fs::exists(chromium))

@@ -2,8 +2,6 @@
 // this process on a free port (app/serve/serve_server.h).
 #ifdef RASTRAY_HAVE_RENDERERS
 
-#include <unistd.h>
-
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -78,7 +76,7 @@ std::vector<std::string> shellWords(const std::string& line) {
 class ServeTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    base_ = fs::temp_directory_path() / ("rastray-serve-test-" + std::to_string(getpid()));
+    base_ = test::scratchDir();  // the suite's own, while no test runs
     fs::create_directories(base_ / "root" / "sub");
     fs::copy_file(scenePath("three-triangles"), base_ / "root" / "sub" / "three-triangles.gltf");
     fs::copy_file(scenePath("three-triangles"), base_ / "secret.gltf");
@@ -95,7 +93,6 @@ class ServeTest : public ::testing::Test {
     server_->stop();
     thread_.join();
     delete server_;
-    fs::remove_all(base_);
   }
 
   static httplib::Result get(const std::string& target, const std::string& host = "127.0.0.1") {

@@ -4,8 +4,6 @@
 // process on rows made by hand.
 #ifdef RASTRAY_HAVE_RENDERERS
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -30,17 +28,11 @@ using test::runRastray;
 
 using test::slurp;
 
+// A folder of the running test's scratch directory (kept when it fails).
 struct TempFolder {
   std::filesystem::path path;
-  explicit TempFolder(const std::string& tag) {
-    path = std::filesystem::temp_directory_path() /
-           ("rastray-stability-test-" + tag + "-" + std::to_string(getpid()));
-    std::filesystem::remove_all(path);
+  explicit TempFolder(const std::string& tag) : path(rastray::test::scratchDir() / tag) {
     std::filesystem::create_directories(path);
-  }
-  ~TempFolder() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
   }
   std::string operator/(const std::string& name) const { return (path / name).string(); }
 };

@@ -9,8 +9,6 @@
 // of row 5 lie exactly on the yellow triangle's bottom edge y = −0.375.
 #pragma once
 
-#include <unistd.h>
-
 #include <atomic>
 #include <filesystem>
 #include <glm/glm.hpp>
@@ -19,6 +17,7 @@
 #include "common/camera.h"
 #include "common/image.h"
 #include "common/scene.h"
+#include "tests/test_files.h"
 
 namespace rastray::test {
 
@@ -104,17 +103,13 @@ inline Scene quadScene(bool duplicated) {
   return s;
 }
 
-// A fresh directory under the system temporary directory.
+// A fresh folder in the running test's scratch directory (test_files.h:
+// kept when the test fails).
 inline std::string makeTempDir(const std::string& name) {
   static std::atomic<int> counter{0};
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() /
-      ("rastray_compare_" + name + "_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
-  std::filesystem::remove_all(dir);
+  const std::filesystem::path dir = scratchDir() / (name + "_" + std::to_string(counter++));
   std::filesystem::create_directories(dir);
   return dir.string();
 }
-
-inline std::string scenePath(const std::string& name) { return std::string(RASTRAY_SCENES) + "/" + name; }
 
 }  // namespace rastray::test

@@ -160,7 +160,6 @@ TEST(Maps, MismatchMapColoursEachPixelByItsClass) {
   // One entry per pixel class (Genuine is the last).
   EXPECT_EQ(mismatchLegend().size(), size_t(PixelVisibility::Genuine) + 1);
   EXPECT_EQ(cssColor(mismatchColor(PixelVisibility::Genuine)), "#ff0000");
-  std::filesystem::remove_all(dir);
 }
 
 TEST(Maps, HeatMapScalesToTheLargestDifference) {
@@ -179,7 +178,6 @@ TEST(Maps, HeatMapScalesToTheLargestDifference) {
   EXPECT_EQ(glm::ivec3(px[12], px[13], px[14]), bytes(bar.stops.back().srgb));
   EXPECT_EQ(glm::ivec3(px[4], px[5], px[6]), bytes(bar.stops[2].srgb));  // 0.25 of 0.5: the middle stop
   EXPECT_NE(bar.cssGradient().find("#000004 0%"), std::string::npos) << bar.cssGradient();
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "common/image.h"
-#include "tests/compare/frames.h"
 #include "tests/app/run_command.h"
+#include "tests/compare/frames.h"
 
 namespace rastray {
 namespace {
@@ -32,7 +32,6 @@ class CompareCli : public ::testing::Test {
     writeExr(b, fb, ColorPrecision::Float);
     writeExr(same, fa, ColorPrecision::Float);
   }
-  void TearDown() override { std::filesystem::remove_all(dir); }
 
   std::string dir, a, b, same;
   const std::string scene = test::scenePath("three-triangles.gltf");

@@ -14,8 +14,8 @@
 
 #include "common/image.h"
 #include "common/scene.h"
-#include "tests/compare/frames.h"
 #include "tests/app/run_command.h"
+#include "tests/compare/frames.h"
 
 namespace rastray {
 namespace {
@@ -95,7 +95,6 @@ class VisibilityOnly : public ::testing::Test {
     image.depth[k] = std::numeric_limits<float>::infinity();
     writeVisibilityOnly(vis, image);
   }
-  void TearDown() override { std::filesystem::remove_all(dir); }
 
   std::string dir, full, vis;
   uint64_t hits = 0;  // in the full render

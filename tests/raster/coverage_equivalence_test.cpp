@@ -13,6 +13,11 @@
 #include "raster/setup.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
+// Tests here render on 2 or more threads (the ThreadSanitizer stage runs them), except those marked quick.
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
@@ -98,6 +103,7 @@ std::vector<TriangleSetup> setupScene(const Scene& scene, const Camera& camera, 
 
 using Sample = std::tuple<int, int, int>;
 
+RASTRAY_TEST_LABELS_OF(CoverageEquivalence, BlockWalkVisitsTheReferenceSamplesInOrder, "quick");
 TEST(CoverageEquivalence, BlockWalkVisitsTheReferenceSamplesInOrder) {
   const Camera camera = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
   for (uint32_t seed = 1; seed <= 6; ++seed) {
@@ -159,6 +165,7 @@ PassResult depthPass(const std::vector<TriangleSetup>& setups, const SampleGrid&
   return r;
 }
 
+RASTRAY_TEST_LABELS_OF(CoverageEquivalence, FastDepthPassWritesTheReferenceKeysAndWinners, "quick");
 TEST(CoverageEquivalence, FastDepthPassWritesTheReferenceKeysAndWinners) {
   const Camera ortho = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
   const Camera persp =
@@ -247,7 +254,7 @@ TEST(CoverageEquivalence, RendersMatchTheReferenceWalkWithMaskAndBlend) {
   for (int spp : {1, 4}) {
     RasterOptions options;
     options.spp = spp;
-    options.shadows = ShadowMode::None;
+    options.shadows = RasterShadows::None;
     const RenderOutput fast = test::render(scene, camera, options);
     options.referenceCoverage = true;
     const RenderOutput slow = test::render(scene, camera, options);

@@ -11,6 +11,8 @@
 #include "raster/setup.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
 namespace rastray {
 namespace {
 
@@ -101,7 +103,8 @@ Prepared prepare(const Scene& scene, DepthFormat format, double factor, double u
 DepthTarget rasterize(const Prepared& p, std::vector<uint32_t> order, DepthFunc func, DepthFormat format) {
   DepthTarget target(32, 32, 4);
   DepthPassCounters n;
-  rasterDepthPass(p.setups, order, p.grid, TileRect{0, 0, 32, 32}, format, func, {}, TraceRequest{}, &target, &n);
+  rasterDepthPass(p.setups, order, p.grid, TileRect{0, 0, 32, 32}, format, func, {}, TraceRequest{}, &target,
+                  &n);
   return target;
 }
 
@@ -117,6 +120,7 @@ Scene overlappingScene() {
   return scene;
 }
 
+RASTRAY_TEST_LABELS_OF(DepthTest, RandomSubmissionOrdersGiveIdenticalBuffers, "threads");
 TEST(DepthTest, RandomSubmissionOrdersGiveIdenticalBuffers) {
   const Scene scene = overlappingScene();
   std::mt19937 rng(11);
@@ -143,6 +147,7 @@ TEST(DepthTest, RandomSubmissionOrdersGiveIdenticalBuffers) {
     }
 }
 
+RASTRAY_TEST_LABELS_OF(PolygonOffset, UnitsAndFactorMoveCoplanarSurfaces, "threads");
 TEST(PolygonOffset, UnitsAndFactorMoveCoplanarSurfaces) {
   // Instance 0 alone, then instance 1 set up with an offset: negative pulls
   // it in front of its coplanar twin, positive pushes it behind.

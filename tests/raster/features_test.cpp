@@ -12,6 +12,11 @@
 #include "raster/rasterizer.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
+// Every test here renders on 2 or more threads (the ThreadSanitizer stage runs them).
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
@@ -57,7 +62,7 @@ TEST(ShadowMaps, MatchAnalyticShadowsWithoutAcne) {
     o.shadowMapSize = 512;
     std::vector<SampleHit> hits;
     const RenderOutput lit = renderRasterWithHits(scene, analyzeScene(scene), camera, o, &hits);
-    o.shadows = ShadowMode::None;
+    o.shadows = RasterShadows::None;
     const RenderOutput unshadowed = test::render(scene, camera, o);
     EXPECT_GT(lit.counters.get("raster.shadow_map_triangles"), 0u);
     EXPECT_EQ(lit.counters.get("raster.shadow_maps"), type == LightType::Point ? 6u : 1u);
@@ -88,7 +93,7 @@ TEST(ShadowMaps, BlendOccludersLetOneMinusAlphaThrough) {
   RasterOptions o;
   o.shadowMapSize = 512;
   const RenderOutput lit = test::render(scene, camera, o);
-  o.shadows = ShadowMode::None;
+  o.shadows = RasterShadows::None;
   const RenderOutput unshadowed = test::render(scene, camera, o);
   EXPECT_GT(lit.counters.get("raster.shadow_map_transmissive_fragments"), 0u);
   size_t inShadow = 0, wrong = 0;
@@ -131,7 +136,7 @@ TEST(HybridHook, ShaderUsesTheGivenVisibilityAndSecondaryRays) {
   scene.materials[1] = mirror;
   const Camera camera = test::perspectiveCamera(32, 32, 1.2, glm::dvec3(0, 6, 0.01), glm::dvec3(0), 0.1);
   RasterOptions o;
-  o.shadows = ShadowMode::Rays;
+  o.shadows = RasterShadows::Traced;
   EXPECT_THROW(test::render(scene, camera, o), InputError);  // rays need the hybrid's visibility
   NoLight dark;
   Magenta magenta;

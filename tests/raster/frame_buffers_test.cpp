@@ -13,6 +13,11 @@
 #include "raster/frame_buffers.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
+// Every test here renders on 2 or more threads (the ThreadSanitizer stage runs them).
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
@@ -47,7 +52,7 @@ TEST(FrameBuffers, StaleStorageGivesTheFreshFrameBitForBit) {
       const std::string what = std::to_string(w) + "x" + std::to_string(h) + " spp " + std::to_string(spp);
       RasterOptions options;
       options.spp = spp;
-      options.shadows = ShadowMode::None;
+      options.shadows = RasterShadows::None;
       const Camera cornellCamera = makeCamera(cornell, {}, w, h);
       const Camera triangleCamera = test::orthoCamera(w, 1.0);
       Camera camera = triangleCamera;
@@ -81,7 +86,7 @@ TEST(FrameBuffers, WireframeOverStaleTargetMatchesFresh) {
   const Scene cornell = loadScene(test::scenePath("cornell-box.gltf"));
   const Scene triangle = oneTriangle();
   RasterOptions options;
-  options.shadows = ShadowMode::None;
+  options.shadows = RasterShadows::None;
   options.wireframe = true;
   const Camera camera = test::orthoCamera(80, 1.0);
   const RenderOutput fresh = test::render(triangle, camera, options);
@@ -100,7 +105,7 @@ TEST(FrameBuffers, BusyPoolFallsBackToOwnBuffers) {
   const Scene triangle = oneTriangle();
   const Camera camera = test::orthoCamera(64, 1.0);
   RasterOptions options;
-  options.shadows = ShadowMode::None;
+  options.shadows = RasterShadows::None;
   const RenderOutput fresh = test::render(triangle, camera, options);
   RasterFrameBuffers pool;
   FrameBufferLease held(&pool);  // the pool is busy
@@ -140,7 +145,7 @@ TEST(FrameBuffers, TileSamplesLeftByAnotherFrameDoNotShow) {
       RasterOptions options;
       options.spp = spp;
       options.shadingRate = rate;
-      options.shadows = ShadowMode::None;
+      options.shadows = RasterShadows::None;
       RenderOutput after[2];
       std::vector<SampleHit> hits[2];
       for (int k = 0; k < 2; ++k) {
@@ -161,7 +166,9 @@ TEST(FrameBuffers, TileSamplesLeftByAnotherFrameDoNotShow) {
         ++background;
         EXPECT_EQ(after[0].image.color[i], glm::vec4(0.0f)) << what << " pixel " << i;
       }
-      if (spp == 1) EXPECT_GT(background, after[0].image.instance.size() / 2) << what;
+      if (spp == 1) {
+        EXPECT_GT(background, after[0].image.instance.size() / 2) << what;
+      }
     }
   }
 }

@@ -46,11 +46,11 @@ TEST(RasterMemoryEstimate, ShadowMapsOnlyWhenDrawnSixFacesPerPointLight) {
   scene.lights = {point, sun};
   RasterOptions options;
   options.shadowMapSize = 512;
-  options.shadows = ShadowMode::Map;
+  options.shadows = RasterShadows::Map;
   MemoryEstimate maps;
   addRasterFrameMemory(scene, options, 1000, 0.0, 1, maps);
   EXPECT_EQ(part(maps, "shadow maps"), (6u + 1u) * 512u * 512u * 4u);
-  options.shadows = ShadowMode::None;
+  options.shadows = RasterShadows::None;
   MemoryEstimate none;
   addRasterFrameMemory(scene, options, 1000, 0.0, 1, none);
   EXPECT_EQ(part(none, "shadow maps"), 0u);

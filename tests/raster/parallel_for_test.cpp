@@ -18,6 +18,11 @@
 
 #include "common/parallel.h"
 
+#include "tests/test_labels.h"
+
+// Tests here render on 2 or more threads (the ThreadSanitizer stage runs them), except those marked quick.
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
@@ -44,6 +49,7 @@ TEST(ParallelFor, TwoThreadsSeeTheCallersWritesAndTheCallerSeesTheirs) {
 }
 
 // The index form, as the tile loops use it: every index once.
+RASTRAY_TEST_LABELS_OF(ParallelFor, IndexFormVisitsEveryIndexOnce, "quick");
 TEST(ParallelFor, IndexFormVisitsEveryIndexOnce) {
   std::vector<int> seen(1000, 0);
   parallelFor(0, int(seen.size()), [&](int i) { seen[size_t(i)] += 1; });

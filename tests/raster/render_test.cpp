@@ -14,6 +14,11 @@
 #include "raster/resolve.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
+// Every test here renders on 2 or more threads (the ThreadSanitizer stage runs them).
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
@@ -115,7 +120,7 @@ TEST(OrderIndependence, ShuffledTrianglesAndThreadCountsGiveIdenticalBuffers) {
   const Camera camera = sceneCamera(scene, 80, 60);
   RasterOptions o;
   o.spp = 4;
-  o.shadows = ShadowMode::None;
+  o.shadows = RasterShadows::None;
   const RenderOutput ref = render(scene, camera, o);
   std::mt19937 rng(3);
   Scene shuffled = scene;
@@ -209,7 +214,7 @@ TEST(Textures, MipLevelGrowsTowardsTheHorizonOnTheGrazingPlane) {
   const Camera camera = sceneCamera(scene, 64, 64);
   RasterOptions o;
   o.keepSamples = true;
-  o.shadows = ShadowMode::None;
+  o.shadows = RasterShadows::None;
   const RenderOutput out = renderRaster(scene, analysis, camera, o);
   const Shader shader(scene, analysis, camera, o.shading, nullptr, nullptr);
   // Level of detail along the centre column, bottom (near) to top (far).

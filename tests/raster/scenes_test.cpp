@@ -9,6 +9,11 @@
 #include "raster/rasterizer.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
+// Every test here renders on 2 or more threads (the ThreadSanitizer stage runs them).
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 

@@ -14,6 +14,11 @@
 #include "raster/shadow_map.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
+// Every test here renders on 2 or more threads (the ThreadSanitizer stage runs them).
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 

@@ -10,6 +10,11 @@
 #include "raster/coverage.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
+// Tests here render on 2 or more threads (the ThreadSanitizer stage runs them), except those marked quick.
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
@@ -45,6 +50,7 @@ CoverageCount countCoverage(const Scene& scene, const Camera& camera, int spp) {
   return c;
 }
 
+RASTRAY_TEST_LABELS_OF(SampleGrid, FixedPointRefinementPutsEverySampleOnTheGrid, "quick");
 TEST(SampleGrid, FixedPointRefinementPutsEverySampleOnTheGrid) {
   EXPECT_EQ(makeSampleGrid(1, 64, 64).k, 1);
   EXPECT_EQ(makeSampleGrid(16, 64, 64).k, 1);
@@ -176,6 +182,7 @@ TEST(Setup, DegenerateTrianglesCoverNothing) {
   for (size_t i = 0; i < c.front.size(); ++i) EXPECT_EQ(c.front[i] + c.back[i], 0);
 }
 
+RASTRAY_TEST_LABELS_OF(Clip, NearPlaneSplitsKeepParentBarycentricsAndShareVertices, "quick");
 TEST(Clip, NearPlaneSplitsKeepParentBarycentricsAndShareVertices) {
   Camera camera = test::perspectiveCamera(32, 32, 1.0, glm::dvec3(0), glm::dvec3(0, 0, -1), 0.5);
   const ClipSpace space = makeClipSpace(camera, 1000.0);

@@ -59,7 +59,7 @@ TEST(ShadingKernelRaster, ReferenceShadingOptionChangesThePath) {
   const Scene scene = loadScene(test::scenePath("cornell-box.gltf"));
   const Camera camera = makeCamera(scene, {}, 64, 48);
   RasterOptions options;
-  options.shadows = ShadowMode::None;
+  options.shadows = RasterShadows::None;
   const RenderOutput kernel = test::render(scene, camera, options);
   options.shading.referenceShading = true;
   const RenderOutput reference = test::render(scene, camera, options);

@@ -7,12 +7,18 @@
 #include "raster/resolve.h"
 #include "raster_test_util.h"
 
+#include "tests/test_labels.h"
+
+// Tests here render on 2 or more threads (the ThreadSanitizer stage runs them), except those marked quick.
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
 using test::addMesh;
 using test::colored;
 
+RASTRAY_TEST_LABELS_OF(Over, PremultipliedRedOverRedAndNotCommutative, "quick");
 TEST(Over, PremultipliedRedOverRedAndNotCommutative) {
   const glm::vec4 red(0.5f, 0.0f, 0.0f, 0.5f);  // 50 % bright red, premultiplied
   EXPECT_EQ(over(red, red), glm::vec4(0.75f, 0.0f, 0.0f, 0.75f));

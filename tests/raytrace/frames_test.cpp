@@ -12,6 +12,11 @@
 #include "raytrace/ray_caster.h"
 #include "test_scenes.h"
 
+#include "tests/test_labels.h"
+
+// Every test here renders on 2 or more threads (the ThreadSanitizer stage runs them).
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 

@@ -17,6 +17,8 @@
 #include "raytrace/ray_offset.h"
 #include "test_scenes.h"
 
+#include "tests/test_labels.h"
+
 namespace rastray {
 namespace {
 
@@ -247,6 +249,7 @@ TEST(ErrorBoundOffset, TriangleNearTheOriginIsOffsetTiny) {
 // in random directions leaving the surface. A ray that hits the triangle
 // again returns transmittance 0. Every direction Embree's denominator is
 // certified for must come back 1.
+RASTRAY_TEST_LABELS_OF(ErrorBoundOffset, EmbreeDoesNotHitTheTriangleAgain, "threads");
 TEST(ErrorBoundOffset, EmbreeDoesNotHitTheTriangleAgain) {
   std::mt19937 rng(23);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -300,6 +303,7 @@ TEST(ErrorBoundOffset, EmbreeDoesNotHitTheTriangleAgain) {
 // plane (no Embree term) is hit again by about 8 % of these rays; the
 // error-bound origin by none, and nor is the RTG one (its 256 ULPs are
 // plenty here).
+RASTRAY_TEST_LABELS_OF(ErrorBoundOffset, EmbreeDoesNotHitASlopedFloorAgain, "threads");
 TEST(ErrorBoundOffset, EmbreeDoesNotHitASlopedFloorAgain) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0), unit(0.0, 1.0);

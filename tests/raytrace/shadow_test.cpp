@@ -10,10 +10,15 @@
 #include "raytrace/ray_offset.h"
 #include "test_scenes.h"
 
+#include "tests/test_labels.h"
+
+// Tests here render on 2 or more threads (the ThreadSanitizer stage runs them), except those marked quick.
+RASTRAY_TEST_LABELS("threads");
+
 namespace rastray {
 namespace {
 
-
+RASTRAY_TEST_LABELS_OF(RayOffset, MovesByUlpsAlongTheNormalAndScalesWithMagnitude, "quick");
 TEST(RayOffset, MovesByUlpsAlongTheNormalAndScalesWithMagnitude) {
   const glm::vec3 n(0.0f, 1.0f, 0.0f);
   for (float y : {1.0f, -1.0f, 1e5f, -1e6f}) {
