@@ -190,11 +190,13 @@ const std::vector<std::string>& autoReferenceArgs() {
   return args;
 }
 
-// What the auto reference renders with the cell: the picture's framing,
-// culling and the pose (an animated scene's reference is the same frame).
+// What the auto reference renders with the cell: the picture's framing
+// (the file's camera or the overrides), culling, the pose (an animated
+// scene's reference is the same frame), the lights kept and the exposure.
 bool definesPicture(const std::string& option) {
-  static const std::set<std::string> picture = {"--size",  "--eye",  "--target", "--up",   "--yfov",
-                                                "--znear", "--zfar", "--cull",   "--time", "--animation"};
+  static const std::set<std::string> picture = {"--size",      "--camera", "--eye",     "--target", "--up",
+                                                "--yfov",      "--znear",  "--zfar",    "--cull",   "--time",
+                                                "--animation", "--lights", "--exposure"};
   return picture.count(option) > 0;
 }
 

@@ -79,6 +79,9 @@ TEST(StabilityGeometry, SliverFanIsWatertightUpToAspect1e6) {
 
 TEST(StabilityGeometry, PixelAlignedTilingFollowsTheTopLeftRule) {
   runCase("pixel-aligned-tiling", [](const Row& r) {
+    // The ray caster's own tie decisions are shown, not held (SPEC lets it
+    // pick either triangle of a shared edge).
+    if (isVariant(r, "raytrace ties")) return;
     expectNoGenuine(r);
     EXPECT_EQ(r.metric, 0.0) << where(r) << ": " << r.metricName;  // owner differs from the top-left one
     EXPECT_EQ(measure(r, "interior samples not covered once (this renderer)"), 0.0) << where(r);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "app/studies/sweep.h"
 #include "app/studies/sweep_report.h"
@@ -125,6 +126,21 @@ TEST(SweepPlan, BadVaryNamesTheOption) {
   EXPECT_THROW(parseShard("2/2"), InputError);
   EXPECT_THROW(parseShard("1-2"), InputError);
   EXPECT_EQ(parseShard("1/3").n, 3);
+}
+
+// The auto reference is the cell's own picture: a cell that keeps no light
+// or doubles the exposure is scored against a reference that does the same
+// (against the default picture every pixel would be off).
+TEST(SweepCommand, AutoReferenceKeepsTheCellsLightsAndExposure) {
+  const std::string report = test::scratchPath("sweep");
+  const auto r = runRastray({"sweep", test::scenePath("cornell-box.gltf"), "--vary", "lights=all,none",
+                             "--vary", "exposure=0,1", "--renderer", "raytrace", "--size", "24", "18",
+                             "--spp", "16", "--repeat", "1", "--report", report});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report + "/sweep.json"));
+  ASSERT_EQ(j.at("rows").size(), 4u) << j.dump();
+  for (const nlohmann::json& row : j.at("rows"))
+    EXPECT_LT(row.at("errors").at("rms").get<double>(), 0.05) << row.dump();
 }
 
 TEST(SweepCommand, BadVaryExits2WithOneLineBeforeAnythingRuns) {
