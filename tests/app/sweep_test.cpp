@@ -130,7 +130,8 @@ TEST(SweepPlan, BadVaryNamesTheOption) {
 
 // The auto reference is the cell's own picture: a cell that keeps no light
 // or doubles the exposure is scored against a reference that does the same
-// (against the default picture every pixel would be off).
+// (against the default picture: RMS 1.03 to 1.1; the default cell 0.07,
+// the reference being 64 spp at depth 16).
 TEST(SweepCommand, AutoReferenceKeepsTheCellsLightsAndExposure) {
   const std::string report = test::scratchPath("sweep");
   const auto r = runRastray({"sweep", test::scenePath("cornell-box.gltf"), "--vary", "lights=all,none",
@@ -140,7 +141,8 @@ TEST(SweepCommand, AutoReferenceKeepsTheCellsLightsAndExposure) {
   const nlohmann::json j = nlohmann::json::parse(slurp(report + "/sweep.json"));
   ASSERT_EQ(j.at("rows").size(), 4u) << j.dump();
   for (const nlohmann::json& row : j.at("rows"))
-    EXPECT_LT(row.at("errors").at("rms").get<double>(), 0.05) << row.dump();
+    EXPECT_LT(row.at("errors").at("rms").get<double>(), 0.2)
+        << row.dump();  // 1.03 to 1.1 against the default picture
 }
 
 TEST(SweepCommand, BadVaryExits2WithOneLineBeforeAnythingRuns) {
