@@ -14,6 +14,7 @@
 #include <hwy/highway.h>
 
 #include "common/primary_refinement-inl.h"
+#include "common/run_lanes-inl.h"
 #include "common/shading_kernel.h"
 
 #ifndef RASTRAY_SHADING_KERNEL_LANES
@@ -40,7 +41,7 @@ struct LaneBlock {
   alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
   // Inputs, per run of lanes on one triangle (indexed by `run`): stored
   // once, read as a broadcast by a vector of lanes on one run, else
-  // gathered (RunValue).
+  // gathered (RunLanes, common/run_lanes-inl.h).
   alignas(64) float ngX[kBlock], ngY[kBlock], ngZ[kBlock];  // face normal (double, memoised), rounded
   alignas(64) float authored[kBlock];  // 1: interpolate the corner normals below, 0: the face normal
   alignas(64) float n0X[kBlock], n0Y[kBlock], n0Z[kBlock];
@@ -105,18 +106,6 @@ using kernel_detail::LaneLight;
 // Lanes per vector of the running target.
 size_t KernelLanes() { return hn::Lanes(hn::ScalableTag<float>()); }
 
-// A per-run value for the vector of lanes starting at lane i: a broadcast
-// when they all lie on one run (runs are non-decreasing, so first == last
-// says so), else a gather. The same value either way.
-template <class D>
-HWY_INLINE hn::Vec<D> RunValue(D d, const LaneBlock* b, size_t i, const float* table) {
-  const size_t N = hn::Lanes(d);
-  const int32_t first = b->run[i];
-  if (first == b->run[i + N - 1]) return hn::Set(d, table[first]);
-  const hn::RebindToSigned<D> di;
-  return hn::GatherIndex(d, table, hn::Load(di, b->run + i));
-}
-
 // The lighting normal of each lane (Shader::shade's n): the shading
 // normal (authored, interpolated and normalised; else the face normal) on
 // the viewer's side, or the face normal's when that one faces away.
@@ -127,7 +116,7 @@ void LanesNormals(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto inf = hn::Set(d, std::numeric_limits<float>::infinity());
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto get = [&](const float* table) { return RunValue(d, b, i, table); };
+    const RunLanes<decltype(d)> get(d, b->run, i);  // per-run values (common/run_lanes-inl.h)
     const auto b0 = hn::Load(d, b->b0 + i), b1 = hn::Load(d, b->b1 + i), b2 = hn::Load(d, b->b2 + i);
     const auto sx =
         hn::Add(hn::Add(hn::Mul(b0, get(b->n0X)), hn::Mul(b1, get(b->n1X))), hn::Mul(b2, get(b->n2X)));
@@ -245,7 +234,7 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto invPi = hn::Set(d, eyeLight ? 1.0f : float(0.31830988618379067154));
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto diffuse = RunValue(d, b, i, b->diffuseWeight);
+    const auto diffuse = RunLanes<decltype(d)>(d, b->run, i)(b->diffuseWeight);
     const auto hasDiffuse = hn::Gt(diffuse, zero);
     const auto alpha = hn::Load(d, b->alpha + i);
     const auto channel = [&](const float* albedo, const float* sum, const float* emit, float* out) {
