@@ -1,7 +1,9 @@
 // Pass 1's depth test and write (rasterDepthPass, coverage.h).
 //
 // The fast path walks each triangle block by block (block_coverage.h) and
-// tests the covered samples of a block from its masks. In front of that, a
+// tests the covered samples of a block from its masks; a block the
+// triangle covers whole takes its keys a block row at a time, eight in
+// SIMD doubles (depth_keys.h, the same bits). In front of that, a
 // hierarchical depth test per block of the rect: an upper bound of the
 // keys stored in the block against a lower bound of the triangle's keys
 // there; a block where the triangle is behind everything stored is skipped
@@ -16,6 +18,7 @@
 
 #include "raster/coverage.h"
 #include "raster/depth_bounds.h"
+#include "raster/depth_keys.h"
 
 namespace rastray {
 
@@ -202,14 +205,48 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         if (bounds.culls(
                 hb, [&] { return std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos)); }))
           continue;
-        if (c == BlockClass::Accept) {
-          const uint64_t full = fullBlockMask(b);
-          for (int s = 0; s < spp; ++s) masks[s] = full;
-        } else {
-          blockMasks(t, scratch, U, spp, b, lo, masks);
-        }
         // The same test as `test` above without the trace (not traced here).
         uint32_t written = 0, writtenMax = 0;
+        const auto testKey = [&](int px, int py, int s, uint32_t key) {
+          const size_t i = target->index(px, py, s);
+          const uint32_t stored = keys[i];
+          if (key > stored) return;
+          if (key == stored &&
+              (keysOnly || !passesDepthTest(func, key, id, stored,
+                                            winners[i] == kNoSetup ? UINT64_MAX : setups[winners[i]].id())))
+            return;
+          if (alphaTest && !alphaTest(t, px, py, s)) {
+            ++counters->alphaRejected;
+            return;
+          }
+          ++counters->samplesPassed;
+          keys[i] = key;
+          if (!keysOnly) winners[i] = index;
+          ++written;
+          writtenMax = std::max(writtenMax, key);
+        };
+        if (c == BlockClass::Accept) {
+          // Every sample covered: each block row's keys eight at a time
+          // (depth_keys.h: the bits of sampleDepthKey), then tested.
+          counters->samplesTested += uint64_t(b.w) * uint64_t(b.h) * uint64_t(spp);
+          for (int s = 0; s < spp; ++s) {
+            const glm::dvec2& q = grid.positions[size_t(s)];
+            double column[8];
+            planeColumnTerms(t.depth, b.x, q.x, column);
+            for (int py = b.y; py < b.y + b.h; ++py) {
+              uint32_t rowKeys[8];
+              planeRowKeys(format, column, planeRowTerm(t.depth, py, q.y), rowKeys);
+              for (int k = 0; k < b.w; ++k) testKey(b.x + k, py, s, rowKeys[k]);
+            }
+          }
+          if (written == 0) continue;
+          if (written == uint32_t(b.w * b.h * spp) && bounds.wholeBlock(b))
+            bounds.setExact(hb, writtenMax);  // every key of the block is new
+          else
+            bounds.markStale(hb);
+          continue;
+        }
+        blockMasks(t, scratch, U, spp, b, lo, masks);
         for (int s = 0; s < spp; ++s) {
           uint64_t m = masks[s];
           counters->samplesTested += uint64_t(bitCount(m));
@@ -217,30 +254,10 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
             const int bit = __builtin_ctzll(m);
             m &= m - 1;
             const int px = b.x + (bit & 7), py = b.y + (bit >> 3);
-            const size_t i = target->index(px, py, s);
-            const uint32_t key = sampleDepthKey(t, grid, format, px, py, s);
-            const uint32_t stored = keys[i];
-            if (key > stored) continue;
-            if (key == stored &&
-                (keysOnly || !passesDepthTest(func, key, id, stored,
-                                              winners[i] == kNoSetup ? UINT64_MAX : setups[winners[i]].id())))
-              continue;
-            if (alphaTest && !alphaTest(t, px, py, s)) {
-              ++counters->alphaRejected;
-              continue;
-            }
-            ++counters->samplesPassed;
-            keys[i] = key;
-            if (!keysOnly) winners[i] = index;
-            ++written;
-            writtenMax = std::max(writtenMax, key);
+            testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s));
           }
         }
-        if (written == 0) continue;
-        if (c == BlockClass::Accept && written == uint32_t(b.w * b.h * spp) && bounds.wholeBlock(b))
-          bounds.setExact(hb, writtenMax);  // every key of the block is new
-        else
-          bounds.markStale(hb);
+        if (written != 0) bounds.markStale(hb);
       }
   }
 }
