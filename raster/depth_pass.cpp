@@ -117,6 +117,35 @@ class BlockDepthBounds {
   std::vector<uint8_t> stale_;
 };
 
+// Whether none of the eight keys equals its stored key (then bit k of
+// *less says keys[k] < stored[k], unsigned); false on a tie, which the
+// caller decides per sample.
+inline bool rowLess(const uint32_t (&keys)[8], const uint32_t* stored, uint32_t* less) {
+#if defined(__SSE2__)
+  const __m128i bias = _mm_set1_epi32(int(0x80000000u));
+  const __m128i k0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(keys));
+  const __m128i k1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(keys + 4));
+  const __m128i s0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(stored));
+  const __m128i s1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(stored + 4));
+  const int ties = _mm_movemask_epi8(_mm_or_si128(_mm_cmpeq_epi32(k0, s0), _mm_cmpeq_epi32(k1, s1)));
+  if (ties != 0) return false;
+  // Unsigned a < b as signed (a ^ 2^31) < (b ^ 2^31).
+  const __m128i l0 = _mm_cmplt_epi32(_mm_xor_si128(k0, bias), _mm_xor_si128(s0, bias));
+  const __m128i l1 = _mm_cmplt_epi32(_mm_xor_si128(k1, bias), _mm_xor_si128(s1, bias));
+  *less = uint32_t(_mm_movemask_ps(_mm_castsi128_ps(l0))) | uint32_t(_mm_movemask_ps(_mm_castsi128_ps(l1)))
+                                                                << 4;
+  return true;
+#else
+  uint32_t m = 0;
+  for (int k = 0; k < 8; ++k) {
+    if (keys[k] == stored[k]) return false;
+    m |= uint32_t(keys[k] < stored[k]) << k;
+  }
+  *less = m;
+  return true;
+#endif
+}
+
 }  // namespace
 
 void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
@@ -207,7 +236,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
           continue;
         // The same test as `test` above without the trace (not traced here).
         uint32_t written = 0, writtenMax = 0;
-        const auto testKey = [&](int px, int py, int s, uint32_t key) {
+        const auto testKey = [&](int px, int py, int s, uint32_t key) __attribute__((always_inline)) {
           const size_t i = target->index(px, py, s);
           const uint32_t stored = keys[i];
           if (key > stored) return;
@@ -236,6 +265,24 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
             for (int py = b.y; py < b.y + b.h; ++py) {
               uint32_t rowKeys[8];
               planeRowKeys(format, column, planeRowTerm(t.depth, py, q.y), rowKeys);
+              if (spp == 1 && b.w == 8 && !alphaTest && !keysOnly) {
+                // The row's eight samples are contiguous: compared at once,
+                // unless a key ties its stored one (the id rule decides).
+                const size_t i = target->index(b.x, py, 0);
+                uint32_t passMask = 0;
+                if (rowLess(rowKeys, keys + i, &passMask)) {
+                  for (int k = 0; k < 8; ++k) {
+                    if (!(passMask >> k & 1u)) continue;
+                    keys[i + size_t(k)] = rowKeys[k];
+                    winners[i + size_t(k)] = index;
+                    writtenMax = std::max(writtenMax, rowKeys[k]);
+                  }
+                  const uint32_t n = uint32_t(__builtin_popcount(passMask));
+                  counters->samplesPassed += n;
+                  written += n;
+                  continue;
+                }
+              }
               for (int k = 0; k < b.w; ++k) testKey(b.x + k, py, s, rowKeys[k]);
             }
           }
