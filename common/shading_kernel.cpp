@@ -14,6 +14,7 @@
 #include <hwy/highway.h>
 
 #include "common/primary_refinement-inl.h"
+#include "common/run_lanes-inl.h"
 #include "common/shading_kernel.h"
 
 #ifndef RASTRAY_SHADING_KERNEL_LANES
@@ -32,21 +33,32 @@ struct LaneBlock {
   size_t lanes = 0;  // used rounded up to whole vectors of the running target: what the lanes run over
   size_t runs = 0;   // entries of the per-run table below
   // Inputs, per lane.
-  alignas(64) int32_t run[kBlock];                             // the lane's run; non-decreasing
-  alignas(64) float dirX[kBlock], dirY[kBlock], dirZ[kBlock];  // primary ray direction
-  alignas(64) float side[kBlock];                        // +1 entering (d·ng < 0, in double), else −1
-  alignas(64) float b0[kBlock], b1[kBlock], b2[kBlock];  // b0 = 1 − b1 − b2 in double, rounded
+  alignas(64) int32_t run[kBlock];                                 // the lane's run; non-decreasing
+  alignas(64) int64_t run64[kBlock];                               // the same, for double lanes
+  alignas(64) double dirXd[kBlock], dirYd[kBlock], dirZd[kBlock];  // primary ray direction (unit)
+  alignas(64) float b1[kBlock], b2[kBlock];                        // refined barycentrics
+  // Per lane, from the above in double lanes (LanesSurface).
+  alignas(64) float dirX[kBlock], dirY[kBlock], dirZ[kBlock];  // the direction, rounded
+  alignas(64) float side[kBlock];  // +1 entering (d·ng < 0, in double), else −1
+  alignas(64) float b0[kBlock];    // b0 = 1 − b1 − b2 in double, rounded
+  alignas(64) double posX[kBlock], posY[kBlock],
+      posZ[kBlock];  // b0·p0 + b1·p1 + b2·p2 (not with the eye light)
   alignas(64) float albedoR[kBlock], albedoG[kBlock], albedoB[kBlock];  // base colour RGB (scalar, as Shader)
   alignas(64) float emitR[kBlock], emitG[kBlock], emitB[kBlock];        // emission (scalar, as Shader)
   // Inputs, per run of lanes on one triangle (indexed by `run`): stored
   // once, read as a broadcast by a vector of lanes on one run, else
-  // gathered (RunValue).
+  // gathered (RunLanes, common/run_lanes-inl.h).
   alignas(64) float ngX[kBlock], ngY[kBlock], ngZ[kBlock];  // face normal (double, memoised), rounded
   alignas(64) float authored[kBlock];  // 1: interpolate the corner normals below, 0: the face normal
   alignas(64) float n0X[kBlock], n0Y[kBlock], n0Z[kBlock];
   alignas(64) float n1X[kBlock], n1Y[kBlock], n1Z[kBlock];
   alignas(64) float n2X[kBlock], n2Y[kBlock], n2Z[kBlock];
   alignas(64) float diffuseWeight[kBlock];  // (1 − w)(1 − t)
+  // Per run, in double: the face normal (memoised) and the corner positions.
+  alignas(64) double ngXd[kBlock], ngYd[kBlock], ngZd[kBlock];
+  alignas(64) double p0X[kBlock], p0Y[kBlock], p0Z[kBlock];
+  alignas(64) double p1X[kBlock], p1Y[kBlock], p1Z[kBlock];
+  alignas(64) double p2X[kBlock], p2Y[kBlock], p2Z[kBlock];
   // Per lane again.
   alignas(64) float alpha[kBlock];  // BLEND: base alpha; else 1
   // Per light, refilled for each light: light − position (the vector to the
@@ -105,16 +117,49 @@ using kernel_detail::LaneLight;
 // Lanes per vector of the running target.
 size_t KernelLanes() { return hn::Lanes(hn::ScalableTag<float>()); }
 
-// A per-run value for the vector of lanes starting at lane i: a broadcast
-// when they all lie on one run (runs are non-decreasing, so first == last
-// says so), else a gather. The same value either way.
-template <class D>
-HWY_INLINE hn::Vec<D> RunValue(D d, const LaneBlock* b, size_t i, const float* table) {
+// The lanes' double-precision inputs, as Shader::shade and makeSurfacePoint
+// compute them per hit: the entering side (glm::dot(d, ng) < 0, (x + y) +
+// z), b0 = (1 − b1) − b2, the surface position (b0·p0 + b1·p1) + b2·p2 per
+// component (with `positions`), and the direction rounded to float.
+void LanesSurface(LaneBlock* b, bool positions) {
+  const hn::ScalableTag<double> d;
+  const hn::Rebind<float, decltype(d)> df;
   const size_t N = hn::Lanes(d);
-  const int32_t first = b->run[i];
-  if (first == b->run[i + N - 1]) return hn::Set(d, table[first]);
-  const hn::RebindToSigned<D> di;
-  return hn::GatherIndex(d, table, hn::Load(di, b->run + i));
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0), minusOne = hn::Set(d, -1.0);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const RunLanes<decltype(d)> get(d, b->run64, i);
+    const auto dx = hn::Load(d, b->dirXd + i), dy = hn::Load(d, b->dirYd + i), dz = hn::Load(d, b->dirZd + i);
+    const auto dot =
+        hn::Add(hn::Add(hn::Mul(dx, get(b->ngXd)), hn::Mul(dy, get(b->ngYd))), hn::Mul(dz, get(b->ngZd)));
+    hn::Store(hn::DemoteTo(df, hn::IfThenElse(hn::Lt(dot, zero), one, minusOne)), df, b->side + i);
+    hn::Store(hn::DemoteTo(df, dx), df, b->dirX + i);
+    hn::Store(hn::DemoteTo(df, dy), df, b->dirY + i);
+    hn::Store(hn::DemoteTo(df, dz), df, b->dirZ + i);
+    const auto b1 = hn::PromoteTo(d, hn::Load(df, b->b1 + i)), b2 = hn::PromoteTo(d, hn::Load(df, b->b2 + i));
+    const auto b0 = hn::Sub(hn::Sub(one, b1), b2);
+    hn::Store(hn::DemoteTo(df, b0), df, b->b0 + i);
+    if (!positions) continue;
+    const auto corner = [&](const double* p0, const double* p1, const double* p2, double* out) {
+      hn::Store(hn::Add(hn::Add(hn::Mul(b0, get(p0)), hn::Mul(b1, get(p1))), hn::Mul(b2, get(p2))), d,
+                out + i);
+    };
+    corner(b->p0X, b->p1X, b->p2X, b->posX);
+    corner(b->p0Y, b->p1Y, b->p2Y, b->posY);
+    corner(b->p0Z, b->p1Z, b->p2Z, b->posZ);
+  }
+}
+
+// toLight = light − position per lane, in double, rounded once to float.
+void LanesToLight(LaneBlock* b, double lightX, double lightY, double lightZ) {
+  const hn::ScalableTag<double> d;
+  const hn::Rebind<float, decltype(d)> df;
+  const size_t N = hn::Lanes(d);
+  const auto lx = hn::Set(d, lightX), ly = hn::Set(d, lightY), lz = hn::Set(d, lightZ);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    hn::Store(hn::DemoteTo(df, hn::Sub(lx, hn::Load(d, b->posX + i))), df, b->toLightX + i);
+    hn::Store(hn::DemoteTo(df, hn::Sub(ly, hn::Load(d, b->posY + i))), df, b->toLightY + i);
+    hn::Store(hn::DemoteTo(df, hn::Sub(lz, hn::Load(d, b->posZ + i))), df, b->toLightZ + i);
+  }
 }
 
 // The lighting normal of each lane (Shader::shade's n): the shading
@@ -127,7 +172,7 @@ void LanesNormals(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto inf = hn::Set(d, std::numeric_limits<float>::infinity());
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto get = [&](const float* table) { return RunValue(d, b, i, table); };
+    const RunLanes<decltype(d)> get(d, b->run, i);  // per-run values (common/run_lanes-inl.h)
     const auto b0 = hn::Load(d, b->b0 + i), b1 = hn::Load(d, b->b1 + i), b2 = hn::Load(d, b->b2 + i);
     const auto sx =
         hn::Add(hn::Add(hn::Mul(b0, get(b->n0X)), hn::Mul(b1, get(b->n1X))), hn::Mul(b2, get(b->n2X)));
@@ -245,7 +290,7 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto invPi = hn::Set(d, eyeLight ? 1.0f : float(0.31830988618379067154));
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto diffuse = RunValue(d, b, i, b->diffuseWeight);
+    const auto diffuse = RunLanes<decltype(d)>(d, b->run, i)(b->diffuseWeight);
     const auto hasDiffuse = hn::Gt(diffuse, zero);
     const auto alpha = hn::Load(d, b->alpha + i);
     const auto channel = [&](const float* albedo, const float* sum, const float* emit, float* out) {
@@ -311,6 +356,8 @@ HWY_AFTER_NAMESPACE();
 namespace rastray {
 
 HWY_EXPORT(KernelLanes);
+HWY_EXPORT(LanesSurface);
+HWY_EXPORT(LanesToLight);
 HWY_EXPORT(LanesNormals);
 HWY_EXPORT(LanesLightWeight);
 HWY_EXPORT(LanesAccumulate);
@@ -395,7 +442,10 @@ LaneLight laneLight(const Light& light) {
 class BlockShader {
  public:
   explicit BlockShader(const Shader& shader)
-      : shader_(shader), scene_(shader.scene()), vectorLanes_(HWY_DYNAMIC_DISPATCH(KernelLanes)()) {
+      : shader_(shader),
+        scene_(shader.scene()),
+        vectorLanes_(HWY_DYNAMIC_DISPATCH(KernelLanes)()),
+        visible_(shader.visibility() && !shader.eyeLight() && !shader.scene().lights.empty()) {
     for (const Light& light : scene_.lights) lights_.push_back(laneLight(light));
   }
 
@@ -421,19 +471,19 @@ class BlockShader {
       b.n1X[r] = run_.n1.x, b.n1Y[r] = run_.n1.y, b.n1Z[r] = run_.n1.z;
       b.n2X[r] = run_.n2.x, b.n2Y[r] = run_.n2.y, b.n2Z[r] = run_.n2.z;
       b.diffuseWeight[r] = (1.0f - m.mirrorWeight()) * (1.0f - m.transmission);
+      b.ngXd[r] = run_.ng.x, b.ngYd[r] = run_.ng.y, b.ngZd[r] = run_.ng.z;
+      b.p0X[r] = run_.p0.x, b.p0Y[r] = run_.p0.y, b.p0Z[r] = run_.p0.z;
+      b.p1X[r] = run_.p1.x, b.p1Y[r] = run_.p1.y, b.p1Z[r] = run_.p1.z;
+      b.p2X[r] = run_.p2.x, b.p2Y[r] = run_.p2.y, b.p2Z[r] = run_.p2.z;
     }
     b.run[i] = int32_t(b.runs - 1);
+    b.run64[i] = int64_t(b.runs - 1);
     const Instance& inst = *run_.inst;
     const glm::uvec3 t = run_.corners;
-    const double b0 = 1.0 - double(h.b1) - double(h.b2);
-    // The side in double, from the face normal in double, as
-    // makeSurfacePoint and Shader::shade decide it.
-    const bool entering = isEntering(h.direction, run_.ng);
-    b.side[i] = entering ? 1.0f : -1.0f;
-    b.dirX[i] = float(h.direction.x);
-    b.dirY[i] = float(h.direction.y);
-    b.dirZ[i] = float(h.direction.z);
-    b.b0[i] = float(b0);
+    // The side, b0, the rounded direction and the position: LanesSurface.
+    b.dirXd[i] = h.direction.x;
+    b.dirYd[i] = h.direction.y;
+    b.dirZd[i] = h.direction.z;
     b.b1[i] = h.b1;
     b.b2[i] = h.b2;
 
@@ -441,9 +491,12 @@ class BlockShader {
     // steps, here with the textures sampled through the pixel footprint.
     glm::vec4 base = m.baseColorFactor;
     glm::vec3 emit = m.emissive;
-    const bool textured = samplesTexture(shader_, m);
-    const bool visible = shader_.visibility() && !shader_.eyeLight() && !scene_.lights.empty();
-    if (textured || visible) {
+    if (&m != material_) {
+      material_ = &m;
+      textured_ = samplesTexture(shader_, m);
+    }
+    const bool textured = textured_;
+    if (textured || visible_) {
       // The full surface point: the footprint and the visibility callback
       // take it (the same one Shader::shade would get).
       points_[i] = makeSurfacePoint(scene_, SampleHit{h.instance, h.triangle, 0.0f, h.b1, h.b2});
@@ -453,6 +506,7 @@ class BlockShader {
       base = shader_.baseColor(points_[i], fp);
       emit = shader_.emission(points_[i], fp);
     } else if (inst.hasColors) {
+      const double b0 = 1.0 - double(h.b1) - double(h.b2);
       const glm::vec4 color =
           float(b0) * scene_.colors[t.x] + h.b1 * scene_.colors[t.y] + h.b2 * scene_.colors[t.z];
       base *= color;
@@ -464,7 +518,6 @@ class BlockShader {
     b.emitG[i] = emit.g;
     b.emitB[i] = emit.b;
     b.alpha[i] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
-    if (!shader_.eyeLight()) positions_[i] = b0 * run_.p0 + double(h.b1) * run_.p1 + double(h.b2) * run_.p2;
   }
 
   // Shades the gathered lanes and writes their colours; empties the block.
@@ -473,6 +526,7 @@ class BlockShader {
     if (b.used == 0) return;
     padLanes();
     const bool eyeLight = shader_.eyeLight();
+    HWY_DYNAMIC_DISPATCH(LanesSurface)(&b, !eyeLight);
     HWY_DYNAMIC_DISPATCH(LanesNormals)(&b, eyeLight);
     if (!eyeLight) {
       const LightVisibility* visibility = shader_.visibility();
@@ -480,12 +534,7 @@ class BlockShader {
         const Light& light = scene_.lights[l];
         if (light.type != LightType::Directional) {
           // The vector to the light in double, rounded once.
-          for (size_t i = 0; i < b.used; ++i) {
-            const glm::dvec3 v = light.position - positions_[i];
-            b.toLightX[i] = float(v.x);
-            b.toLightY[i] = float(v.y);
-            b.toLightZ[i] = float(v.z);
-          }
+          HWY_DYNAMIC_DISPATCH(LanesToLight)(&b, light.position.x, light.position.y, light.position.z);
         }
         HWY_DYNAMIC_DISPATCH(LanesLightWeight)(&b, lights_[l]);
         if (visibility) {
@@ -550,23 +599,20 @@ class BlockShader {
   }
 
   // Fills the lanes from `used` to a whole number of vectors with a
-  // harmless surface (the last run's normals, no light, no colour), never
-  // read back.
+  // harmless surface (the last run's normals and corners at b0 = 1, no
+  // colour), never read back.
   void padLanes() {
     LaneBlock& b = block_;
     b.lanes = (b.used + vectorLanes_ - 1) / vectorLanes_ * vectorLanes_;
     for (size_t i = b.used; i < b.lanes; ++i) {
-      b.dirX[i] = b.dirY[i] = 0.0f;
-      b.dirZ[i] = -1.0f;
-      b.side[i] = 1.0f;
-      b.run[i] = int32_t(b.runs - 1);  // the last run's normals; no colour below
-      b.b0[i] = 1.0f;
+      b.dirXd[i] = b.dirYd[i] = 0.0;
+      b.dirZd[i] = -1.0;
+      b.run[i] = int32_t(b.runs - 1);  // the last run's normals and corners; no colour below
+      b.run64[i] = int64_t(b.runs - 1);
       b.b1[i] = b.b2[i] = 0.0f;
       b.albedoR[i] = b.albedoG[i] = b.albedoB[i] = 0.0f;
       b.emitR[i] = b.emitG[i] = b.emitB[i] = 0.0f;
       b.alpha[i] = 1.0f;
-      b.toLightX[i] = b.toLightY[i] = 0.0f;
-      b.toLightZ[i] = 1.0f;
       b.visR[i] = b.visG[i] = b.visB[i] = 1.0f;
     }
   }
@@ -574,11 +620,13 @@ class BlockShader {
   const Shader& shader_;
   const Scene& scene_;
   const size_t vectorLanes_;
+  const bool visible_;  // lights with a visibility callback: lanes need their full surface point
+  const Material* material_ = nullptr;  // the last lane's, and whether it samples a texture
+  bool textured_ = false;
   std::vector<LaneLight> lights_;
   TriangleRun run_;
   LaneBlock block_;
   glm::vec4* outputs_[kBlock];
-  glm::dvec3 positions_[kBlock];
   SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback
 };
 

@@ -9,13 +9,14 @@
 //                            (intersectTrianglePlane: far from the origin
 //                            the ray's t must not lose the plane; in double
 //                            SIMD lanes for a batch, primary_refinement.h),
-//                            and per hit the surface position (b0·p0 +
-//                            b1·p1 + b2·p2, it becomes shadow-ray origins
-//                            and shadow-map lookups), the vector to each
-//                            point or spot light (light − position, rounded
-//                            to float only after the subtraction), the face
-//                            normal (memoised per triangle) and the
-//                            entering side.
+//                            and per hit, in double SIMD lanes, the surface
+//                            position (b0·p0 + b1·p1 + b2·p2, it becomes
+//                            shadow-ray origins and shadow-map lookups),
+//                            the vector to each point or spot light
+//                            (light − position, rounded to float only
+//                            after the subtraction) and the entering side
+//                            (d·ng against the face normal, memoised per
+//                            triangle).
 //   float, SIMD lanes        COLOR_0 and shading-normal interpolation and
 //                            normalisation, the facing normal, the eye
 //                            light, each light's distance, direction,

@@ -143,10 +143,13 @@ uint64_t forEachCoveredSample(CoveragePath path, const TriangleSetup& t, const S
 }
 
 // A per-sample depth target: keys (smaller = nearer) and the winning
-// setup index; sample (x, y, s) lives at ((y·width) + x)·spp + s. Without
+// setup index over the pixels [x0, x0 + width) × [y0, y0 + height) (the
+// whole image, origin 0, or one tile's rectangle: a tile-local target);
+// sample (x, y, s) lives at (((y − y0)·width) + x − x0)·spp + s. Without
 // winners (keysOnly) it is a plain depth map.
 struct DepthTarget {
   int width = 0, height = 0, spp = 1;
+  int x0 = 0, y0 = 0;  // the first pixel stored
   std::vector<uint32_t> keys;
   std::vector<uint32_t> winners;
   DepthTarget() = default;
@@ -157,7 +160,7 @@ struct DepthTarget {
         keys(size_t(w) * size_t(h) * size_t(samples), kClearDepthKey),
         winners(keysOnly ? 0 : keys.size(), kNoSetup) {}
   size_t index(int x, int y, int s) const {
-    return (size_t(y) * size_t(width) + size_t(x)) * size_t(spp) + size_t(s);
+    return (size_t(y - y0) * size_t(width) + size_t(x - x0)) * size_t(spp) + size_t(s);
   }
 };
 

@@ -1,7 +1,9 @@
 // Pass 1's depth test and write (rasterDepthPass, coverage.h).
 //
 // The fast path walks each triangle block by block (block_coverage.h) and
-// tests the covered samples of a block from its masks. In front of that, a
+// tests the covered samples of a block from its masks; a block the
+// triangle covers whole takes its keys a block row at a time, eight in
+// SIMD doubles (depth_keys.h, the same bits). In front of that, a
 // hierarchical depth test per block of the rect: an upper bound of the
 // keys stored in the block against a lower bound of the triangle's keys
 // there; a block where the triangle is behind everything stored is skipped
@@ -16,6 +18,7 @@
 
 #include "raster/coverage.h"
 #include "raster/depth_bounds.h"
+#include "raster/depth_keys.h"
 
 namespace rastray {
 
@@ -114,6 +117,35 @@ class BlockDepthBounds {
   std::vector<uint8_t> stale_;
 };
 
+// Whether none of the eight keys equals its stored key (then bit k of
+// *less says keys[k] < stored[k], unsigned); false on a tie, which the
+// caller decides per sample.
+inline bool rowLess(const uint32_t (&keys)[8], const uint32_t* stored, uint32_t* less) {
+#if defined(__SSE2__)
+  const __m128i bias = _mm_set1_epi32(int(0x80000000u));
+  const __m128i k0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(keys));
+  const __m128i k1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(keys + 4));
+  const __m128i s0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(stored));
+  const __m128i s1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(stored + 4));
+  const int ties = _mm_movemask_epi8(_mm_or_si128(_mm_cmpeq_epi32(k0, s0), _mm_cmpeq_epi32(k1, s1)));
+  if (ties != 0) return false;
+  // Unsigned a < b as signed (a ^ 2^31) < (b ^ 2^31).
+  const __m128i l0 = _mm_cmplt_epi32(_mm_xor_si128(k0, bias), _mm_xor_si128(s0, bias));
+  const __m128i l1 = _mm_cmplt_epi32(_mm_xor_si128(k1, bias), _mm_xor_si128(s1, bias));
+  *less = uint32_t(_mm_movemask_ps(_mm_castsi128_ps(l0))) | uint32_t(_mm_movemask_ps(_mm_castsi128_ps(l1)))
+                                                                << 4;
+  return true;
+#else
+  uint32_t m = 0;
+  for (int k = 0; k < 8; ++k) {
+    if (keys[k] == stored[k]) return false;
+    m |= uint32_t(keys[k] < stored[k]) << k;
+  }
+  *less = m;
+  return true;
+#endif
+}
+
 }  // namespace
 
 void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
@@ -202,14 +234,66 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         if (bounds.culls(
                 hb, [&] { return std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos)); }))
           continue;
-        if (c == BlockClass::Accept) {
-          const uint64_t full = fullBlockMask(b);
-          for (int s = 0; s < spp; ++s) masks[s] = full;
-        } else {
-          blockMasks(t, scratch, U, spp, b, lo, masks);
-        }
         // The same test as `test` above without the trace (not traced here).
         uint32_t written = 0, writtenMax = 0;
+        const auto testKey = [&](int px, int py, int s, uint32_t key) __attribute__((always_inline)) {
+          const size_t i = target->index(px, py, s);
+          const uint32_t stored = keys[i];
+          if (key > stored) return;
+          if (key == stored &&
+              (keysOnly || !passesDepthTest(func, key, id, stored,
+                                            winners[i] == kNoSetup ? UINT64_MAX : setups[winners[i]].id())))
+            return;
+          if (alphaTest && !alphaTest(t, px, py, s)) {
+            ++counters->alphaRejected;
+            return;
+          }
+          ++counters->samplesPassed;
+          keys[i] = key;
+          if (!keysOnly) winners[i] = index;
+          ++written;
+          writtenMax = std::max(writtenMax, key);
+        };
+        if (c == BlockClass::Accept) {
+          // Every sample covered: each block row's keys eight at a time
+          // (depth_keys.h: the bits of sampleDepthKey), then tested.
+          counters->samplesTested += uint64_t(b.w) * uint64_t(b.h) * uint64_t(spp);
+          for (int s = 0; s < spp; ++s) {
+            const glm::dvec2& q = grid.positions[size_t(s)];
+            double column[8];
+            planeColumnTerms(t.depth, b.x, q.x, column);
+            for (int py = b.y; py < b.y + b.h; ++py) {
+              uint32_t rowKeys[8];
+              planeRowKeys(format, column, planeRowTerm(t.depth, py, q.y), rowKeys);
+              if (spp == 1 && b.w == 8 && !alphaTest && !keysOnly) {
+                // The row's eight samples are contiguous: compared at once,
+                // unless a key ties its stored one (the id rule decides).
+                const size_t i = target->index(b.x, py, 0);
+                uint32_t passMask = 0;
+                if (rowLess(rowKeys, keys + i, &passMask)) {
+                  for (int k = 0; k < 8; ++k) {
+                    if (!(passMask >> k & 1u)) continue;
+                    keys[i + size_t(k)] = rowKeys[k];
+                    winners[i + size_t(k)] = index;
+                    writtenMax = std::max(writtenMax, rowKeys[k]);
+                  }
+                  const uint32_t n = uint32_t(__builtin_popcount(passMask));
+                  counters->samplesPassed += n;
+                  written += n;
+                  continue;
+                }
+              }
+              for (int k = 0; k < b.w; ++k) testKey(b.x + k, py, s, rowKeys[k]);
+            }
+          }
+          if (written == 0) continue;
+          if (written == uint32_t(b.w * b.h * spp) && bounds.wholeBlock(b))
+            bounds.setExact(hb, writtenMax);  // every key of the block is new
+          else
+            bounds.markStale(hb);
+          continue;
+        }
+        blockMasks(t, scratch, U, spp, b, lo, masks);
         for (int s = 0; s < spp; ++s) {
           uint64_t m = masks[s];
           counters->samplesTested += uint64_t(bitCount(m));
@@ -217,30 +301,10 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
             const int bit = __builtin_ctzll(m);
             m &= m - 1;
             const int px = b.x + (bit & 7), py = b.y + (bit >> 3);
-            const size_t i = target->index(px, py, s);
-            const uint32_t key = sampleDepthKey(t, grid, format, px, py, s);
-            const uint32_t stored = keys[i];
-            if (key > stored) continue;
-            if (key == stored &&
-                (keysOnly || !passesDepthTest(func, key, id, stored,
-                                              winners[i] == kNoSetup ? UINT64_MAX : setups[winners[i]].id())))
-              continue;
-            if (alphaTest && !alphaTest(t, px, py, s)) {
-              ++counters->alphaRejected;
-              continue;
-            }
-            ++counters->samplesPassed;
-            keys[i] = key;
-            if (!keysOnly) winners[i] = index;
-            ++written;
-            writtenMax = std::max(writtenMax, key);
+            testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s));
           }
         }
-        if (written == 0) continue;
-        if (c == BlockClass::Accept && written == uint32_t(b.w * b.h * spp) && bounds.wholeBlock(b))
-          bounds.setExact(hb, writtenMax);  // every key of the block is new
-        else
-          bounds.markStale(hb);
+        if (written != 0) bounds.markStale(hb);
       }
   }
 }

@@ -26,7 +26,12 @@ void addRasterFrameMemory(const Scene& scene, const RasterOptions& options, uint
   // The setup's per-vertex codes, alive while setups are made (raster/setup.h).
   transient.add("setup vertex codes", mulSat(scene.positions.size(), kSetupVertexCodeBytes));
   transient.add("tile bins", mulSat(triangles, kBinBytesPerTriangle));
-  transient.add("depth target", mulSat(samples, kDepthTargetSampleBytes));
+  // Frame-sized only where the wireframe reads it after the tiles; else
+  // one tile's target per thread (raster/tile_renderer.h).
+  const uint64_t tileSamples = uint64_t(kTileSize) * kTileSize * uint64_t(options.spp);
+  transient.add("depth target",
+                options.wireframe ? mulSat(samples, kDepthTargetSampleBytes)
+                                  : mulSat(mulSat(tileSamples, uint64_t(threads)), kDepthTargetSampleBytes));
   if (options.shadows == RasterShadows::Map && !scene.lights.empty()) {
     // Every face of every light's map stays until the frame ends; one
     // face's setups and a candidate mask exist while it is drawn.
@@ -38,7 +43,6 @@ void addRasterFrameMemory(const Scene& scene, const RasterOptions& options, uint
   }
   if (transparentLayers > 0.0) {
     // Fragments and shaded layers of the tiles in flight, one per thread.
-    const uint64_t tileSamples = uint64_t(kTileSize) * kTileSize * uint64_t(options.spp);
     const double perTile =
         double(tileSamples) * transparentLayers * double(sizeof(BlendFragment) + sizeof(BlendLayer));
     transient.add("transparency fragments", uint64_t(std::min(perTile * threads, 1.8e19)));

@@ -35,19 +35,15 @@ struct PrimaryRayConstants {
   glm::dvec3 constantPart;  // m2·(−1) + m3·0, per component
 };
 
-// hits[i] = interpolatedHit(setups[winners[i]], positions[i]) and
-// rays[i] = PrimaryRays(camera)(positions[i]), for i < count: in SIMD lanes
-// for a perspective camera, else the scalar reference below.
-void primarySamples(const PrimaryRayConstants& camera, const TriangleSetup* setups, const uint32_t* winners,
-                    const glm::dvec2* positions, size_t count, SampleHit* hits, Ray* rays);
-
-// The scalar reference: the same results one sample at a time.
+// The scalar reference of the lanes' first steps: hits[i] =
+// interpolatedHit(setups[winners[i]], positions[i]) and rays[i] =
+// PrimaryRays(camera)(positions[i]), one sample at a time.
 void primarySamplesReference(const PrimaryRayConstants& camera, const TriangleSetup* setups,
                              const uint32_t* winners, const glm::dvec2* positions, size_t count,
                              SampleHit* hits, Ray* rays);
 
-// The deferred shading's inputs in one pass: hits[i] as primarySamples
-// gives them, and out[i] = refinePrimaryHit(scene, ray_i, hits[i],
+// The deferred shading's inputs in one pass: hits[i] as
+// primarySamplesReference gives them, and out[i] = refinePrimaryHit(scene, ray_i, hits[i],
 // footprints[i]) with ray_i = PrimaryRays(camera)(positions[i]), as
 // refinePrimaryHits would give it, bit for bit. For a perspective camera
 // each block of samples is gathered once (the setup's planes and the

@@ -128,11 +128,14 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   // Every tile: pass 1, shading, pass 2, compositing, resolve.
   start = Clock::now();
   const TileRenderer renderer(scene, analysis, camera, options, shader, grid, setups);
+  // A frame-sized depth target only where the wireframe reads it after
+  // the tiles; otherwise each tile keeps a target of its own rectangle.
   // Reused storage holds the last frame's values: each tile clears its
   // rectangle of the target, and the resolve writes every pixel.
   FrameBufferLease buffers(options.frameBuffers);
   bool targetCleared = false;
-  DepthTarget& target = buffers.target(camera.width, camera.height, options.spp, &targetCleared);
+  DepthTarget* target =
+      options.wireframe ? &buffers.target(camera.width, camera.height, options.spp, &targetCleared) : nullptr;
   out.image = buffers.image(camera.width, camera.height);
   std::vector<std::vector<DeepSample>> deep(options.keepSamples ? size_t(tiles.count()) : 0);
   std::vector<std::vector<uint32_t>> deepCounts(deep.size());
@@ -146,7 +149,7 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
     const TileBins bins{opaqueBins[t], analysis.transparency ? &blendBins[t] : nullptr};
     const TileOutputs outputs{&out.image, options.keepSamples ? &deep[t] : nullptr,
                               options.keepSamples ? &deepCounts[t] : nullptr, hits};
-    renderer.render(tiles.rect(tile), bins, &target, !targetCleared, outputs, counters.local());
+    renderer.render(tiles.rect(tile), bins, target, !targetCleared, outputs, counters.local());
   });
   throwIfStopped(options.cancel);
   const double tileSeconds = secondsSince(start);
@@ -181,7 +184,7 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   if (options.wireframe) {
     WireframeStyle style;
     style.halo = options.halo;
-    wirePixels = drawWireframe(setups, grid, target, options.depthFormat, style, &out.image);
+    wirePixels = drawWireframe(setups, grid, *target, options.depthFormat, style, &out.image);
     out.passesRun.push_back(options.halo ? "wireframe: hidden lines removed, halos"
                                          : "wireframe: hidden lines removed");
   }

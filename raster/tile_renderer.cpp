@@ -56,19 +56,43 @@ void clearTileTarget(const TileRect& rect, DepthTarget* target) {
   }
 }
 
-// The tile's samples, kept per thread so a tile allocates nothing once they
-// have grown; a tile that finds them in use (a nested tile on the same
-// thread) takes its own.
+// The tile's samples and its tile-local depth target, kept per thread so
+// a tile allocates nothing once they have grown; a tile that finds them in
+// use (a nested tile on the same thread) takes its own.
 struct SampleScratch {
   TileSamples samples;
+  DepthTarget target;
   bool busy = false;
 };
 
+// `target` as the depth target of `rect` alone, cleared: a tile's keys and
+// winners stay in the core's caches, and no frame-sized target is filled
+// or written back.
+void makeTileTarget(const TileRect& rect, int spp, DepthTarget* target) {
+  target->width = rect.x1 - rect.x0;
+  target->height = rect.y1 - rect.y0;
+  target->spp = spp;
+  target->x0 = rect.x0;
+  target->y0 = rect.y0;
+  const size_t n = size_t(target->width) * size_t(target->height) * size_t(spp);
+  target->keys.assign(n, kClearDepthKey);
+  target->winners.assign(n, kNoSetup);
+}
+
 }  // namespace
 
-void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarget* target, bool clearTarget,
-                          const TileOutputs& out, ThreadCounters& n) const {
-  if (clearTarget) clearTileTarget(rect, target);
+void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarget* frameTarget,
+                          bool clearTarget, const TileOutputs& out, ThreadCounters& n) const {
+  thread_local SampleScratch scratch;
+  DepthTarget ownTarget;
+  const bool reuse = !scratch.busy;
+  DepthTarget* target = frameTarget;
+  if (!target) {
+    target = reuse ? &scratch.target : &ownTarget;
+    makeTileTarget(rect, grid_.spp, target);
+  } else if (clearTarget) {
+    clearTileTarget(rect, target);
+  }
   const TileSampleIndex index{rect, grid_.spp};
   // The one trace check of the tile: an empty request unless the traced
   // pixel lies here.
@@ -92,9 +116,7 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
   const Clock::time_point t0 = Clock::now();
   opaquePass(rect, bins.opaque, trace, target, n);
   const Clock::time_point t1 = Clock::now();
-  thread_local SampleScratch scratch;
   TileSamples own;
-  const bool reuse = !scratch.busy;
   TileSamples& samples = reuse ? scratch.samples : own;
   scratch.busy = true;
   struct Release {
@@ -113,7 +135,7 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
   const Clock::time_point t3 = Clock::now();
 
   resolveTile(rect, grid_.spp, centre_, samples, out.image);
-  if (out.hits) copyHits(index, samples, *target, out.hits);
+  if (out.hits) copyHits(index, samples, out.hits);
   if (out.deep)
     appendDeepSamples(index, layers, *target, opaqueColor.empty() ? samples.color : opaqueColor, out);
   n.depthSeconds += seconds(t0, t1);

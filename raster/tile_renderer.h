@@ -91,7 +91,7 @@ struct TileOutputs {
   FlatImage* image;
   std::vector<DeepSample>* deep;      // per pixel: its samples' layers, then opaque surfaces
   std::vector<uint32_t>* deepCounts;  // entries of `deep` per pixel, in tile order
-  std::vector<SampleHit>* hits;       // whole frame, DepthTarget order
+  std::vector<SampleHit>* hits;       // whole frame: sample (x, y, s) at (y·width + x)·spp + s
 };
 
 class TileRenderer {
@@ -101,10 +101,12 @@ class TileRenderer {
                const std::vector<TriangleSetup>& setups);
 
   // Pass 1, deferred shading, pass 2, compositing, resolve, hits and deep
-  // samples of one tile. `target` is the frame's depth target; the tile
-  // writes only its own samples, and first clears them when `clearTarget`
-  // (reused storage: raster/frame_buffers.h).
-  void render(const TileRect& rect, const TileBins& bins, DepthTarget* target, bool clearTarget,
+  // samples of one tile. `frameTarget` is the frame's depth target, for a
+  // caller that reads it after the tiles (the wireframe): the tile writes
+  // only its own samples, and first clears them when `clearTarget` (reused
+  // storage: raster/frame_buffers.h). Null: the tile uses a depth target
+  // of its own rectangle (per thread, kept in cache).
+  void render(const TileRect& rect, const TileBins& bins, DepthTarget* frameTarget, bool clearTarget,
               const TileOutputs& out, ThreadCounters& n) const;
 
  private:
@@ -162,8 +164,7 @@ class TileRenderer {
   std::vector<glm::vec4> compositeLayers(const std::vector<BlendLayer>& layers, TileSamples* samples) const;
   void traceLayersAndFinal(const TileSampleIndex& index, const TraceRequest& trace,
                            const std::vector<BlendLayer>& layers, const TileSamples& samples) const;
-  void copyHits(const TileSampleIndex& index, const TileSamples& samples, const DepthTarget& target,
-                std::vector<SampleHit>* hits) const;
+  void copyHits(const TileSampleIndex& index, const TileSamples& samples, std::vector<SampleHit>* hits) const;
   void appendDeepSamples(const TileSampleIndex& index, const std::vector<BlendLayer>& layers,
                          const DepthTarget& target, const std::vector<glm::vec4>& opaqueColor,
                          const TileOutputs& out) const;

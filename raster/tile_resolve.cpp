@@ -52,11 +52,15 @@ void TileRenderer::traceLayersAndFinal(const TileSampleIndex& index, const Trace
 }
 
 void TileRenderer::copyHits(const TileSampleIndex& index, const TileSamples& samples,
-                            const DepthTarget& target, std::vector<SampleHit>* hits) const {
+                            std::vector<SampleHit>* hits) const {
+  // The frame's sample order (the target may be the tile's own).
   const TileRect& rect = index.rect;
+  const size_t spp = size_t(grid_.spp);
   for (int py = rect.y0; py < rect.y1; ++py)
     for (int px = rect.x0; px < rect.x1; ++px)
-      for (int s = 0; s < grid_.spp; ++s) (*hits)[target.index(px, py, s)] = samples.front[index(px, py, s)];
+      for (size_t s = 0; s < spp; ++s)
+        (*hits)[(size_t(py) * size_t(camera_.width) + size_t(px)) * spp + s] =
+            samples.front[index(px, py, int(s))];
 }
 
 // Per pixel: for each sample its layers front to back, then the opaque

@@ -34,9 +34,15 @@ TEST(RasterMemoryEstimate, SetupsAndDepthTargetScaleWithTrianglesAndSamples) {
   addRasterFrameMemory(scene, options, 640 * 480 * 4, 0.0, 2, e);
   EXPECT_EQ(part(e, "triangle setups"), 2000 * sizeof(TriangleSetup));
   EXPECT_EQ(part(e, "setup vertex codes"), 4000 * kSetupVertexCodeBytes);
-  EXPECT_EQ(part(e, "depth target"), 640u * 480u * 4u * 8u);  // key and winner per sample
-  EXPECT_EQ(part(e, "shadow maps"), 0u);                      // no lights
-  EXPECT_EQ(part(e, "transparency fragments"), 0u);           // nothing transparent
+  // Key and winner per sample: one tile's per thread, the whole frame's
+  // only where the wireframe reads it after the tiles.
+  EXPECT_EQ(part(e, "depth target"), 2u * 64u * 64u * 4u * 8u);
+  EXPECT_EQ(part(e, "shadow maps"), 0u);             // no lights
+  EXPECT_EQ(part(e, "transparency fragments"), 0u);  // nothing transparent
+  options.wireframe = true;
+  MemoryEstimate wire;
+  addRasterFrameMemory(scene, options, 640 * 480 * 4, 0.0, 2, wire);
+  EXPECT_EQ(part(wire, "depth target"), 640u * 480u * 4u * 8u);
 }
 
 TEST(RasterMemoryEstimate, ShadowMapsOnlyWhenDrawnSixFacesPerPointLight) {

@@ -1,6 +1,7 @@
-// primarySamples (raster/primary_samples.h): the interpolated hits and
-// primary rays computed in double SIMD lanes have the scalar reference's
-// bits (interpolatedHit, PrimaryRays) for every sample, on every compiled
+// primaryShadeHits (raster/primary_samples.h): the interpolated hits,
+// primary ray directions and refined hits computed in double SIMD lanes
+// have the scalar reference's bits (interpolatedHit, PrimaryRays,
+// refinePrimaryHit) for every sample, on every compiled
 // target, whatever the batch size: cameras near and far from the origin,
 // narrow and wide fields of view, odd image sizes, an orthographic camera,
 // and planes from steep to nearly degenerate.
@@ -54,65 +55,6 @@ std::vector<TriangleSetup> randomSetups(std::mt19937& rng, int width, int height
   return setups;
 }
 
-TEST(PrimarySamples, LanesGiveTheReferenceBitsOnEveryTarget) {
-  std::mt19937 rng(20);
-  struct Case {
-    std::string name;
-    Camera camera;
-  };
-  std::vector<Case> cases;
-  cases.push_back(
-      {"1920x1080 60deg", test::perspectiveCamera(1920, 1080, 1.047, {0.3, 0.2, 4.0}, {0, 0, 0})});
-  cases.push_back(
-      {"97x61 far eye", test::perspectiveCamera(97, 61, 0.7, {1e6, -3e5, 2e6}, {1e6 + 1, -3e5, 0})});
-  cases.push_back({"640x480 narrow, finite zfar",
-                   test::perspectiveCamera(640, 480, 0.01, {0, 5, 0}, {0.2, 0, -1}, 0.5, 1e4)});
-  cases.push_back({"333x777 wide", test::perspectiveCamera(333, 777, 2.9, {-2, 1, 1}, {3, 2, -7})});
-  cases.push_back({"orthographic", test::orthoCamera(128, 3.0)});
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.name);
-    const int w = c.camera.width, h = c.camera.height;
-    const std::vector<TriangleSetup> setups = randomSetups(rng, w, h);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    std::vector<uint32_t> winners;
-    std::vector<glm::dvec2> positions;
-    for (int k = 0; k < 3001; ++k) {
-      // Runs of samples on one setup, as tiles give them, and single ones.
-      winners.push_back(uint32_t((k / (k % 2 ? 1 : 7)) % setups.size()));
-      positions.push_back(k % 11 == 0 ? glm::dvec2(k % w, (k / w) % h) + 0.5
-                                      : glm::dvec2(u(rng) * w, u(rng) * h));
-    }
-    const size_t n = winners.size();
-    const PrimaryRayConstants constants(c.camera);
-    std::vector<SampleHit> expectedHits(n);
-    std::vector<Ray> expectedRays(n);
-    primarySamplesReference(constants, setups.data(), winners.data(), positions.data(), n,
-                            expectedHits.data(), expectedRays.data());
-    // The reference is PrimaryRays and interpolatedHit themselves.
-    const PrimaryRays rays(c.camera);
-    for (size_t i = 0; i < n; i += 97) {
-      ASSERT_TRUE(sameBits(expectedRays[i], rays(positions[i])));
-      ASSERT_TRUE(sameBits(expectedHits[i], interpolatedSampleHit(setups[winners[i]], positions[i])));
-    }
-    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-      SCOPED_TRACE(hwy::TargetName(target));
-      hwy::SetSupportedTargetsForTest(target);
-      for (size_t batch : {size_t(1), size_t(5), size_t(64), size_t(100), n}) {
-        std::vector<SampleHit> hits(n);
-        std::vector<Ray> out(n);
-        for (size_t first = 0; first < n; first += batch)
-          primarySamples(constants, setups.data(), &winners[first], &positions[first],
-                         std::min(batch, n - first), &hits[first], &out[first]);
-        for (size_t i = 0; i < n; ++i) {
-          ASSERT_TRUE(sameBits(hits[i], expectedHits[i])) << "batch " << batch << " sample " << i;
-          ASSERT_TRUE(sameBits(out[i], expectedRays[i])) << "batch " << batch << " sample " << i;
-        }
-      }
-    }
-    hwy::SetSupportedTargetsForTest(0);
-  }
-}
-
 // Random triangles around `centre` (some degenerate, some slivers), each
 // with its own corners, one instance: stored planes the primary rays meet
 // ahead, behind and nearly edge-on.
@@ -144,6 +86,75 @@ bool sameBits(const ShadeHit& a, const ShadeHit& b) {
          std::memcmp(&a.b2, &b.b2, 4) == 0 &&
          std::memcmp(&a.direction, &b.direction, sizeof a.direction) == 0 &&
          a.footprintPosition == b.footprintPosition && a.throughput == b.throughput;
+}
+
+// The fused pass's interpolated hits and primary ray directions against the
+// scalar reference, on planes of every magnitude the renderer produces.
+TEST(PrimarySamples, LanesGiveTheReferenceBitsOnEveryTarget) {
+  std::mt19937 rng(20);
+  struct Case {
+    std::string name;
+    Camera camera;
+  };
+  std::vector<Case> cases;
+  cases.push_back(
+      {"1920x1080 60deg", test::perspectiveCamera(1920, 1080, 1.047, {0.3, 0.2, 4.0}, {0, 0, 0})});
+  cases.push_back(
+      {"97x61 far eye", test::perspectiveCamera(97, 61, 0.7, {1e6, -3e5, 2e6}, {1e6 + 1, -3e5, 0})});
+  cases.push_back({"640x480 narrow, finite zfar",
+                   test::perspectiveCamera(640, 480, 0.01, {0, 5, 0}, {0.2, 0, -1}, 0.5, 1e4)});
+  cases.push_back({"333x777 wide", test::perspectiveCamera(333, 777, 2.9, {-2, 1, 1}, {3, 2, -7})});
+  cases.push_back({"orthographic", test::orthoCamera(128, 3.0)});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const int w = c.camera.width, h = c.camera.height;
+    std::vector<TriangleSetup> setups = randomSetups(rng, w, h);
+    // The stored triangles the fused pass refines on (its refinement is
+    // the next test's subject).
+    const Scene scene = trianglesAround(rng, glm::dvec3(0.0), 2.0);
+    for (size_t i = 0; i < setups.size(); ++i) {
+      setups[i].instance = 0;
+      setups[i].triangle = uint32_t(i % scene.triangles.size());
+    }
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<uint32_t> winners;
+    std::vector<glm::dvec2> positions;
+    for (int k = 0; k < 3001; ++k) {
+      // Runs of samples on one setup, as tiles give them, and single ones.
+      winners.push_back(uint32_t((k / (k % 2 ? 1 : 7)) % setups.size()));
+      positions.push_back(k % 11 == 0 ? glm::dvec2(k % w, (k / w) % h) + 0.5
+                                      : glm::dvec2(u(rng) * w, u(rng) * h));
+    }
+    const size_t n = winners.size();
+    const PrimaryRayConstants constants(c.camera);
+    std::vector<SampleHit> expectedHits(n);
+    std::vector<Ray> expectedRays(n);
+    primarySamplesReference(constants, setups.data(), winners.data(), positions.data(), n,
+                            expectedHits.data(), expectedRays.data());
+    // The reference is PrimaryRays and interpolatedHit themselves.
+    const PrimaryRays rays(c.camera);
+    for (size_t i = 0; i < n; i += 97) {
+      ASSERT_TRUE(sameBits(expectedRays[i], rays(positions[i])));
+      ASSERT_TRUE(sameBits(expectedHits[i], interpolatedSampleHit(setups[winners[i]], positions[i])));
+    }
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      SCOPED_TRACE(hwy::TargetName(target));
+      hwy::SetSupportedTargetsForTest(target);
+      for (size_t batch : {size_t(1), size_t(5), size_t(64), size_t(100), n}) {
+        std::vector<SampleHit> hits(n);
+        std::vector<ShadeHit> out(n);
+        for (size_t first = 0; first < n; first += batch)
+          primaryShadeHits(constants, scene, setups.data(), &winners[first], &positions[first],
+                           &positions[first], std::min(batch, n - first), &hits[first], &out[first]);
+        for (size_t i = 0; i < n; ++i) {
+          ASSERT_TRUE(sameBits(hits[i], expectedHits[i])) << "batch " << batch << " sample " << i;
+          ASSERT_EQ(0, std::memcmp(&out[i].direction, &expectedRays[i].direction, sizeof(glm::dvec3)))
+              << "batch " << batch << " sample " << i;
+        }
+      }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+  }
 }
 
 // primaryShadeHits, the rasterizer's fused pass (interpolation, primary ray

@@ -1,0 +1,60 @@
+// Per-run tables read by a vector of lanes, shared by the SIMD passes that
+// store what is constant along a run of lanes on one triangle once per run
+// (common/shading_kernel.cpp, raster/primary_samples.cpp): lane i holds
+// only the index of its run, runs are non-decreasing within a block, and a
+// vector of lanes reads a table entry by a broadcast when all its lanes lie
+// on one run (first == last says so), else by a gather. The same value
+// either way, so a lane's result does not depend on its neighbours. Include
+// after <hwy/highway.h> in a file compiled per target (foreach_target.h);
+// the guard below re-opens once per target. `run` is read with an aligned
+// load: alignas(64) storage, i a multiple of the lane count.
+#if defined(RASTRAY_RUN_LANES_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef RASTRAY_RUN_LANES_INL_H_
+#undef RASTRAY_RUN_LANES_INL_H_
+#else
+#define RASTRAY_RUN_LANES_INL_H_
+#endif
+
+#include <cstddef>
+
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace rastray {
+namespace HWY_NAMESPACE {
+
+// The runs of the vector of lanes starting at lane i of `run` (a signed
+// integer per lane, as wide as D's lanes: int32_t for float, int64_t for
+// double), and table reads for them.
+template <class D>
+class RunLanes {
+ public:
+  using DI = hwy::HWY_NAMESPACE::RebindToSigned<D>;
+  using Index = hwy::HWY_NAMESPACE::TFromD<DI>;
+  using T = hwy::HWY_NAMESPACE::TFromD<D>;
+
+  RunLanes(D d, const Index* run, size_t i)
+      : d_(d), run_(run + i), first_(run[i]), oneRun_(first_ == run[i + hwy::HWY_NAMESPACE::Lanes(d) - 1]) {}
+
+  // Whether every lane lies on one run (table reads are broadcasts).
+  bool oneRun() const { return oneRun_; }
+
+  // table[run of each lane].
+  HWY_INLINE hwy::HWY_NAMESPACE::Vec<D> operator()(const T* table) const {
+    namespace hn = hwy::HWY_NAMESPACE;
+    if (oneRun_) return hn::Set(d_, table[first_]);
+    return hn::GatherIndex(d_, table, hn::Load(DI(), run_));
+  }
+
+ private:
+  D d_;
+  const Index* run_;
+  Index first_;
+  bool oneRun_;
+};
+
+}  // namespace HWY_NAMESPACE
+}  // namespace rastray
+HWY_AFTER_NAMESPACE();
+
+#endif  // RASTRAY_RUN_LANES_INL_H_
