@@ -195,7 +195,7 @@ TEST(StabilityShadowMaps, SpotLightMapKeepsTheBiasBounds) {
 TEST(StabilityShadowMaps, ShadowBiasOptionReachesEveryShadowMapVariantOnly) {
   CaseContext ctx;
   ctx.shadowMapArgs = {"--shadow-bias", "2", "0.25"};
-  const std::string scene = test::scenePath("cornell-box.gltf");
+  const std::string scene = rastray::test::scenePath("cornell-box.gltf");
   const Args size = {"--size", "16", "12"};
   auto with = [&](Args args) {
     args.insert(args.end(), size.begin(), size.end());
