@@ -134,9 +134,9 @@ TEST(SweepPlan, BadVaryNamesTheOption) {
 // the reference being 64 spp at depth 16).
 TEST(SweepCommand, AutoReferenceKeepsTheCellsLightsAndExposure) {
   const std::string report = test::scratchPath("sweep");
-  const auto r = runRastray({"sweep", test::scenePath("cornell-box.gltf"), "--vary", "lights=all,none",
-                             "--vary", "exposure=0,1", "--renderer", "raytrace", "--size", "24", "18",
-                             "--spp", "16", "--repeat", "1", "--report", report});
+  const auto r = test::runRastray({"sweep", test::scenePath("cornell-box.gltf"), "--vary", "lights=all,none",
+                                   "--vary", "exposure=0,1", "--renderer", "raytrace", "--size", "24", "18",
+                                   "--spp", "16", "--repeat", "1", "--report", report});
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const nlohmann::json j = nlohmann::json::parse(slurp(report + "/sweep.json"));
   ASSERT_EQ(j.at("rows").size(), 4u) << j.dump();
