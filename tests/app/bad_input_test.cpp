@@ -48,8 +48,10 @@ const BadInput kBadInputs[] = {
     {"deep-nesting.gltf", "extras: JSON nesting is deeper than"},
     {"asset-missing.gltf", "asset: is missing"},
     {"asset-version-1.gltf", "asset: version \"1.0\""},
-    {"extension-required-unsupported.gltf", "extensionsRequired: KHR_texture_basisu is required but not supported"},
-    {"draco-stream-corrupt.gltf", "mesh 0 primitive 0 KHR_draco_mesh_compression: Draco stream does not decode"},
+    {"extension-required-unsupported.gltf",
+     "extensionsRequired: KHR_texture_basisu is required but not supported"},
+    {"draco-stream-corrupt.gltf",
+     "mesh 0 primitive 0 KHR_draco_mesh_compression: Draco stream does not decode"},
     {"meshopt-stream-corrupt.gltf", "bufferView 0: meshopt vertex stream does not decode"},
     {"meshopt-fallback-plain-view.gltf", "bufferView 0: refers to fallback buffer 1 without a meshopt"},
     // Wrong types.

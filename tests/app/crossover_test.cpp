@@ -28,6 +28,7 @@
 #include "common/scene.h"
 #include "run_command.h"
 #include "tests/test_files.h"
+#include "tests/test_labels.h"
 #include "xml_check.h"
 
 namespace rastray::crossover {
@@ -123,6 +124,7 @@ CrossoverOptions tinyStudy(const std::string& dir) {
   return o;
 }
 
+RASTRAY_TEST_LABELS_OF(Crossover, TinyStudyWritesCsvJsonAndPlots, "slow");
 TEST(Crossover, TinyStudyWritesCsvJsonAndPlots) {
   const fs::path dir = test::scratchDir();
   const CrossoverOptions options = tinyStudy(dir.string());
@@ -299,6 +301,7 @@ TEST(Crossover, CommandRefusesWhatDoesNotApply) {
 // finished so far stay in crossover.csv and crossover.json (written after
 // each), the account names the cell not finished; --resume keeps those
 // cells as measured and runs the rest.
+RASTRAY_TEST_LABELS_OF(Crossover, InterruptedStudyKeepsFinishedCellsAndResumes, "slow");
 TEST(Crossover, InterruptedStudyKeepsFinishedCellsAndResumes) {
   const fs::path dir = test::scratchDir();
   const fs::path temp = dir / "temp";  // where the study's scratch folder goes

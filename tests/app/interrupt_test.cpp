@@ -26,6 +26,7 @@
 #include "common/interrupt.h"
 #include "tests/app/run_command.h"
 #include "tests/test_files.h"
+#include "tests/test_labels.h"
 
 namespace rastray {
 namespace {
@@ -246,6 +247,7 @@ TEST_F(Interrupt, CrossvalSummaryReadBackGivesTheSameIndex) {
 
 // Two cells: the signal comes once the first is in sweep.csv, while the
 // second (64 spp) renders.
+RASTRAY_TEST_LABELS_OF(Interrupt, SweepKeepsFinishedCellsAndResumes, "slow");
 TEST_F(Interrupt, SweepKeepsFinishedCellsAndResumes) {
   const std::string ref = dir_ + "/ref.exr", report = dir_ + "/sweep";
   ASSERT_EQ(test::runRastray({"render", scene("cornell-box"), "--renderer", "raytrace", "--size", "160",

@@ -77,6 +77,7 @@ std::string joined(const std::vector<std::string>& lines) {
 
 const std::vector<std::string> kSmall = {"--size", "40", "30", "--spp", "4", "--shadow-map-size", "64"};
 
+RASTRAY_TEST_LABELS_OF(RandomCrossval, TwoHundredSeedsHaveNoGenuineMismatches, "threads", "slow");
 TEST(RandomCrossval, TwoHundredSeedsHaveNoGenuineMismatches) {
   std::vector<uint64_t> seeds;
   for (uint64_t s = 0; s < 200; ++s) seeds.push_back(s);
@@ -89,6 +90,7 @@ TEST(RandomCrossval, TwoHundredSeedsHaveNoGenuineMismatches) {
 // depth-tie tolerance; seed 23: nearly coplanar triangles seen at 84°, within
 // the float intersection bound but not the format's), a silhouette miss cascading into the layers behind,
 // grazing triangles cut by a finite far plane (the cut is an edge too).
+RASTRAY_TEST_LABELS_OF(RandomCrossval, SeedsThatFoundBugs, "threads", "slow");
 TEST(RandomCrossval, SeedsThatFoundBugs) {
   const auto failures = crossvalSeeds({23, 39, 47, 53, 97, 119, 132, 166, 172, 186, 190},
                                       {"--size", "80", "60", "--spp", "4", "--shadow-map-size", "64"});

@@ -16,7 +16,6 @@
 
 namespace rastray::test {
 
-
 CommandResult runRastrayAndSignal(const std::vector<std::string>& args, int signal,
                                   const std::function<bool(pid_t)>& ready, bool* signalled) {
   static std::atomic<int> counter{0};

@@ -19,6 +19,10 @@
 #include "app/studies/stability_measure.h"
 #include "tests/app/stability_bounds.h"
 #include "tests/test_files.h"
+#include "tests/test_labels.h"
+
+// Each case renders every variant at its --quick size: seconds each.
+RASTRAY_TEST_LABELS("slow");
 
 namespace rastray::stability {
 namespace {

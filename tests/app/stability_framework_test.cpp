@@ -19,6 +19,7 @@
 #include "app/studies/stability_report.h"
 #include "run_command.h"
 #include "tests/test_files.h"
+#include "tests/test_labels.h"
 
 namespace rastray::stability {
 namespace {
@@ -150,6 +151,7 @@ TEST(StabilityCommand, BadInputExitsTwoWithOneLine) {
 
 // --quick runs exactly the cases marked quick, all of them pass, in under a
 // minute (the CI budget; this machine has 2 cores).
+RASTRAY_TEST_LABELS_OF(StabilityCommand, QuickRunsTheMarkedSubsetUnderAMinute, "slow");
 TEST(StabilityCommand, QuickRunsTheMarkedSubsetUnderAMinute) {
   const TempFolder dir("quick");
   const auto start = std::chrono::steady_clock::now();

@@ -19,8 +19,8 @@
 #include "tests/test_files.h"
 #include "tests/test_labels.h"
 
-// Tests here render on 2 or more threads (the ThreadSanitizer stage runs them), except those marked quick.
-RASTRAY_TEST_LABELS("threads");
+// Each case renders its variants on 2 threads for seconds (threads, slow), except those marked quick.
+RASTRAY_TEST_LABELS("threads", "slow");
 
 namespace rastray::stability {
 namespace {

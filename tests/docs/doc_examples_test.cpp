@@ -17,6 +17,10 @@
 
 #include "tests/docs/doc_examples.h"
 #include "tests/test_files.h"
+#include "tests/test_labels.h"
+
+// Each example runs the built binary as the docs show it: seconds each.
+RASTRAY_TEST_LABELS("slow");
 
 namespace rastray::test::docs {
 namespace {

@@ -103,7 +103,7 @@ std::vector<TriangleSetup> setupScene(const Scene& scene, const Camera& camera, 
 
 using Sample = std::tuple<int, int, int>;
 
-RASTRAY_TEST_LABELS_OF(CoverageEquivalence, BlockWalkVisitsTheReferenceSamplesInOrder, "quick");
+RASTRAY_TEST_LABELS_OF(CoverageEquivalence, BlockWalkVisitsTheReferenceSamplesInOrder, "slow");
 TEST(CoverageEquivalence, BlockWalkVisitsTheReferenceSamplesInOrder) {
   const Camera camera = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
   for (uint32_t seed = 1; seed <= 6; ++seed) {
@@ -165,7 +165,7 @@ PassResult depthPass(const std::vector<TriangleSetup>& setups, const SampleGrid&
   return r;
 }
 
-RASTRAY_TEST_LABELS_OF(CoverageEquivalence, FastDepthPassWritesTheReferenceKeysAndWinners, "quick");
+RASTRAY_TEST_LABELS_OF(CoverageEquivalence, FastDepthPassWritesTheReferenceKeysAndWinners, "slow");
 TEST(CoverageEquivalence, FastDepthPassWritesTheReferenceKeysAndWinners) {
   const Camera ortho = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
   const Camera persp =
