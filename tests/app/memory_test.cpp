@@ -71,11 +71,13 @@ TEST(MaxMemory, CrossvalIsRefusedUpFrontForItsThreeDeepFrames) {
 TEST(MaxMemory, ASweepIsRefusedBeforeItsFirstCell) {
   const std::string dir = test::scratchPath("sweep-memory");
   std::filesystem::remove_all(dir);
-  // Cell 0 (1 spp) fits, cell 1 (64 spp) does not: nothing runs.
-  const auto r = runRastray({"sweep", scene("cornell-box"), "--vary", "spp=1,64", "--size", "2000", "2000",
+  // Cell 0 (200x200) fits, cell 1 (8000x8000: 1.67 GiB of image) does not:
+  // nothing runs. (By samples it no longer can: the rasterizer's depth
+  // target is one tile's per thread, so 64 spp at 2000x2000 needs 420 MiB.)
+  const auto r = runRastray({"sweep", scene("cornell-box"), "--vary", "size=200x200,8000x8000",
                              "--max-memory", "1500M", "--report", dir});
   EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("cornell-box.gltf: cell 1: rendering 2000x2000 at 64 spp (raster) needs about"),
+  EXPECT_NE(r.err.find("cornell-box.gltf: cell 1: rendering 8000x8000 at 1 spp (raster) needs about"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/sweep.csv"));
