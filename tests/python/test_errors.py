@@ -67,10 +67,11 @@ def test_bad_value_gives_the_command_lines_message(tmp_path, cornell, options, c
 
 
 def test_absurd_size_is_refused_before_allocating(cornell):
-    # Within --size's range, far beyond memory (about 545 GiB): refused by
-    # the estimate, under the default limit and under a given one.
+    # Within --size's range, far beyond memory with every sample kept (about
+    # 5 TiB; without deep=True the rasterizer needs only the 7 GiB image):
+    # refused by the estimate, under the default limit and under a given one.
     for options in (dict(), dict(max_memory="1G")):
-        message = raised(rastray.render, cornell, size=(16384, 16384), spp=256, **options)
+        message = raised(rastray.render, cornell, size=(16384, 16384), spp=256, deep=True, **options)
         assert message.startswith(cornell.path + ": rendering 16384x16384 at 256 spp (raster) needs about ")
         assert "above the memory limit" in message
     assert message.endswith("above the memory limit of 1.00 GiB (--max-memory 1G)")
