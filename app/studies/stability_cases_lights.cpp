@@ -13,6 +13,7 @@
 #include "app/studies/stability.h"
 #include "app/studies/stability_far_scene.h"
 #include "app/studies/stability_measure.h"
+#include "common/math_constants.h"
 
 namespace rastray::stability {
 
@@ -105,8 +106,8 @@ void appendLightCases(std::vector<Case>& cases) {
       light.position = glm::dvec3(2.0, 5.0, 4.0);
       light.direction = glm::normalize(glm::dvec3(0.0, 0.5, 0.0) - light.position);
       light.intensity = 60.0f;
-      light.innerConeAngle = float(25.0 * 3.14159265358979323846 / 180.0);
-      light.outerConeAngle = float(35.0 * 3.14159265358979323846 / 180.0);
+      light.innerConeAngle = float(25.0 * kPi / 180.0);
+      light.outerConeAngle = float(35.0 * kPi / 180.0);
       return lightScene(light);
     };
     c.run = [](const CaseContext& ctx, const std::string& path) { return runLight(ctx, "light-spot", path); };
