@@ -9,9 +9,11 @@
 #     llvmpipe with 4x MSAA), 1 and 2 threads;
 #   ray caster vs Embree's viewer: the engine and the Cornell box at
 #     1024x1024, 1 spp, 1 and 2 threads.
-# Like-for-like frames: --shadows none (the peers draw no shadows); the
-# Cornell box's mirror and glass still cost the ray caster secondary rays,
-# which the table's note says.
+# Like-for-like frames: the rasterizer with --shadows none (llvmpipe draws
+# no shadows); the ray caster with --lights none --max-depth 0, the work of
+# the viewer's eyelight shader (one primary ray per pixel, eye light, no
+# shadow, mirror or glass rays: without it the Cornell box's frame would
+# also trace its 4.3 million secondary rays).
 #
 # Usage: bench/peers/table.sh [OUT.csv] [--quick]   (--quick: 640x480, one round)
 # Environment: RASTRAY (default build/rastray), FRAMES (5), ROUNDS (3).
@@ -40,12 +42,12 @@ work=${WORK_DIR:-bench-work}
 rm -f "$out"
 
 cell() {  # scene renderer spp threads W H
-  local rate=() shadows=()
+  local rate=() like=()
   [ "$3" -gt 1 ] && rate=(--shading-rate pixel)
-  [ "$2" = raster ] && shadows=(--shadows none)  # the ray caster's shadow rays are its own kind of ray
+  if [ "$2" = raster ]; then like=(--shadows none); else like=(--lights none --max-depth 0); fi
   echo "table: $2 $1 $5x$6 spp $3 threads $4" >&2
   "$rastray" bench "$1" --renderer "$2" --size "$5" "$6" --spp "$3" "${rate[@]}" --threads "$4" \
-    "${shadows[@]}" --frames "$frames" --peers --rounds "$rounds" --peers-csv "$out" --work-dir "$work" >/dev/null
+    "${like[@]}" --frames "$frames" --peers --rounds "$rounds" --peers-csv "$out" --work-dir "$work" >/dev/null
 }
 
 for scene in scenes/cornell-box.gltf "$engine" terrain:1000000; do
