@@ -30,7 +30,7 @@ MaterialCounts countMaterials(const Scene& scene) {
     c.reflective += m.isReflective();
     c.refractive += m.isRefractive();
     c.emissive += m.isEmissive();
-    c.textured += m.baseColorTexture >= 0 || m.emissiveTexture >= 0;
+    c.textured += m.isTextured();
     c.doubleSided += m.doubleSided;
   }
   return c;
