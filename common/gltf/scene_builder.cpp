@@ -1349,33 +1349,19 @@ int32_t SceneBuilder::decodableTexture(const json& textureInfo, bool data) {
     noteIgnored("texture without a decodable image", "textureInfo");
     return -1;
   }
-  const json* transform = textureTransformOf(textureInfo);
-  if (data) {
-    // A data map: read linearly, a Texture of its own (its image's data
-    // chain is shared, TextureSet).
-    Texture t = scene_.textures[size_t(tex)];
-    t.data = true;
-    if (transform) {
-      const auto pair = [&](const char* key, double fallback) {
-        const auto v = get<std::vector<double>>(*transform, key, {fallback, fallback});
-        return glm::dvec2(v[0], v[1]);
-      };
-      t.transform =
-          TextureTransform(pair("offset", 0.0), get(*transform, "rotation", 0.0), pair("scale", 1.0));
-    }
-    scene_.textures.push_back(t);
-    return int32_t(scene_.textures.size() - 1);
-  }
-  if (!transform) return tex;
-  // KHR_texture_transform: a texture of this textureInfo's own, sharing
-  // the image (and its mip chain, TextureSet) and the sampler.
-  const auto pair = [&](const char* key, double fallback) {
-    const auto v = get<std::vector<double>>(*transform, key, {fallback, fallback});
-    return glm::dvec2(v[0], v[1]);
-  };
+  // KHR_texture_transform and data maps (read linearly) get a texture of
+  // this textureInfo's own, sharing the image (its chain of that kind,
+  // TextureSet) and the sampler.
   Texture t = scene_.textures[size_t(tex)];
-  t.transform = TextureTransform(pair("offset", 0.0), get(*transform, "rotation", 0.0), pair("scale", 1.0));
-  if (t.transform.identity) return tex;
+  t.data = data;
+  if (const json* transform = textureTransformOf(textureInfo)) {
+    const auto pair = [&](const char* key, double fallback) {
+      const auto v = get<std::vector<double>>(*transform, key, {fallback, fallback});
+      return glm::dvec2(v[0], v[1]);
+    };
+    t.transform = TextureTransform(pair("offset", 0.0), get(*transform, "rotation", 0.0), pair("scale", 1.0));
+  }
+  if (!data && t.transform.identity) return tex;
   scene_.textures.push_back(t);
   return int32_t(scene_.textures.size() - 1);
 }
