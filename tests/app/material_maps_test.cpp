@@ -66,12 +66,13 @@ GltfScene quadScene(const GltfMaterial& material, bool light) {
 
 // The colour of the middle pixel in each renderer, rendered in process on
 // one thread; they must agree.
-glm::vec4 centreColour(const GltfScene& scene, const std::string& name) {
+glm::vec4 centreColour(const GltfScene& scene, const std::string& name, const char* first = "raster",
+                       const char* second = "raytrace") {
   const std::string path = test::scratchPath(name + ".gltf");
   scene.write(path);
   const tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
   glm::vec4 colour[2];
-  const char* renderers[2] = {"raster", "raytrace"};
+  const char* renderers[2] = {first, second};
   for (int k = 0; k < 2; ++k) {
     const RenderSettings settings = renderSettingsFrom(
         {"--renderer", renderers[k], "--size", std::to_string(kSize), std::to_string(kSize)});
@@ -143,6 +144,34 @@ TEST(OcclusionMap, ScalesTheEyeLightNotAPunctualLight) {
   lit.materials[0].occlusionTexture = 0;
   lit.textures.push_back(uniformTexture(64, 200, 200));
   EXPECT_NEAR(centreColour(lit, "occlusion-lit").r, lambert({0, 0, 1}), 1e-5);
+}
+
+TEST(OcclusionMap, ScalesReflectedRadiance) {
+  // A mirror (metallic 1, roughness 0) tilted 45° about x reflects the
+  // view (−z) to +y, onto an emissive white quad edge-on to the camera at
+  // y = 3: the mirror shows 1, times ao with the occlusion map. Needs
+  // reflection rays: the ray caster and hybrid.
+  GltfMaterial mirror;
+  mirror.metallic = 1.0f;
+  mirror.roughness = 0.0f;
+  GltfScene s = quadScene(mirror, false);
+  const float c = float(std::sqrt(0.5));
+  const glm::vec3 u(1, 0, 0), v(0, c, -c);  // u × v = (0, c, c): the mirror's normal
+  s.meshes[0].positions = {-u - v, u - v, u + v, -u + v};
+  s.meshes[0].normals.assign(4, glm::vec3(0, c, c));
+  GltfMaterial lamp;
+  lamp.baseColor = glm::vec4(0, 0, 0, 1);
+  lamp.emissive = glm::vec3(1.0f);
+  s.materials.push_back(lamp);
+  GltfMesh ceiling;
+  ceiling.positions = {{-5, 3, 5}, {5, 3, 5}, {5, 3, -5}, {-5, 3, -5}};  // facing −y
+  ceiling.indices = {0, 1, 2, 0, 2, 3};
+  ceiling.material = 1;
+  s.meshes.push_back(ceiling);
+  EXPECT_NEAR(centreColour(s, "occlusion-mirror-none", "hybrid", "raytrace").r, 1.0, 1e-5);
+  s.materials[0].occlusionTexture = 0;
+  s.textures.push_back(uniformTexture(64, 200, 200));
+  EXPECT_NEAR(centreColour(s, "occlusion-mirror", "hybrid", "raytrace").r, 64.0 / 255.0, 1e-5);
 }
 
 TEST(MetallicRoughnessMap, TexelSetsTheMirrorWeight) {
