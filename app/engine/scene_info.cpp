@@ -182,6 +182,10 @@ nlohmann::json sceneInfoJson(const Scene& scene, const CameraOptions& options) {
                     {"mirrored", in.mirrored},
                     {"normals", in.normals == NormalSource::Authored ? "authored" : "flat"},
                     {"vertexColors", in.hasColors},
+                    // Normal-map tangents: stored only for instances whose material has a normal map.
+                    {"tangents", in.firstTangent == kNoId ? "none"
+                                 : in.generatedTangents   ? "generated"
+                                                          : "file"},
                     {"skinned", in.skinned},
                     {"morphed", in.morphed}});
   }

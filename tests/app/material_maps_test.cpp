@@ -5,6 +5,7 @@
 // here by the glTF writer.
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -242,6 +243,20 @@ TEST(MaterialMaps, ClearCoatTestListsOnlyClearcoatAsIgnored) {
   EXPECT_EQ(j["ignored"][0]["text"], "KHR_materials_clearcoat on 6 materials");
   // Every material with a map counts as textured (SPEC §8: mip chains).
   EXPECT_EQ(j["materials"]["textured"], 9);
+  // Tangents only where a normal map needs them (SPEC §8), generated: the
+  // file has no TANGENT. Six materials with normal maps, each on one or
+  // more instances; the others carry none.
+  int generated = 0, none = 0;
+  for (const json& i : j["instanceList"]) {
+    const int32_t material = i["material"].get<int32_t>();
+    const bool normalMapped =
+        std::set<int32_t>{9, 10, 14, 15, 16, 17}.count(material) > 0;  // "normalTexture" in the file
+    EXPECT_EQ(i["tangents"], normalMapped ? "generated" : "none") << i;
+    generated += i["tangents"] == "generated";
+    none += i["tangents"] == "none";
+  }
+  EXPECT_GT(generated, 0);
+  EXPECT_GT(none, 0);
 }
 
 }  // namespace
