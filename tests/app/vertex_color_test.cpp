@@ -136,10 +136,9 @@ TEST(InfoIgnored, ListsEachIgnoredFeatureWithItsCount) {
 
   const auto text = runRastray({"info", path});
   ASSERT_EQ(text.status, 0) << text.err;
-  EXPECT_NE(
-      text.out.find("ignored    texture without a decodable image on 4 textureInfos; "
-                    "EXT_vendor_texture_info on 2 textureInfos; KHR_materials_volume on 1 material\n"),
-      std::string::npos)
+  EXPECT_NE(text.out.find("ignored    texture without a decodable image on 4 textureInfos; "
+                          "EXT_vendor_texture_info on 2 textureInfos; KHR_materials_volume on 1 material\n"),
+            std::string::npos)
       << text.out;
 
   const auto r = runRastray({"info", path, "--json"});
