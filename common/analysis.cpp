@@ -76,9 +76,8 @@ SceneAnalysis analyzeScene(const Scene& scene) {
       decide(scene, Work::ReflectionRays, "reflective", [](const Material& m) { return m.isReflective(); }));
   a.decisions.push_back(
       decide(scene, Work::RefractionRays, "refractive", [](const Material& m) { return m.isRefractive(); }));
-  a.decisions.push_back(decide(scene, Work::Textures, "textured", [](const Material& m) {
-    return m.baseColorTexture >= 0 || m.emissiveTexture >= 0;
-  }));
+  a.decisions.push_back(
+      decide(scene, Work::Textures, "textured", [](const Material& m) { return m.isTextured(); }));
 
   a.transparency = a.needs(Work::TransparencyPass);
   a.alphaTest = a.needs(Work::AlphaTest);

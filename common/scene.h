@@ -81,6 +81,11 @@ struct Texture {
   int32_t image = -1;  // index into Scene::images; -1: no decodable source
   TextureSampler sampler;
   TextureTransform transform;
+  // Data, not colour (normal, metallic-roughness and occlusion maps): the
+  // bytes are read linearly (v / 255), not sRGB-decoded, and alpha is
+  // ignored. The loader gives such textureInfos textures of their own, so
+  // an image used both ways gets one chain of each kind (TextureSet).
+  bool data = false;
 };
 
 struct Material {
@@ -100,9 +105,37 @@ struct Material {
   float ior = 1.5f;           // KHR_materials_ior
   bool isDefault = false;     // made by the loader for primitives without a material
 
-  // SPEC §5: mirror reflection weight metallic × (1 − roughness).
-  float mirrorWeight() const { return metallic * (1.0f - roughness); }
-  bool isReflective() const { return mirrorWeight() > 0.0f; }
+  // The maps of docs/MATERIALS.md, indices into Scene::textures (data
+  // textures, Texture::data), -1: none. All read through the base colour
+  // texture's uv set (Scene::texcoords); the loader drops (and lists) a
+  // map on another set.
+  // normalTexture: tangent-space normal, scaled in x and y by normalScale;
+  // the instance carries tangents (Instance::firstTangent).
+  int32_t normalTexture = -1;
+  float normalScale = 1.0f;
+  // occlusionTexture: R scales indirect light (Shader, SPEC §5) as
+  // 1 + occlusionStrength · (R − 1).
+  int32_t occlusionTexture = -1;
+  float occlusionStrength = 1.0f;
+  // metallicRoughnessTexture: B multiplies `metallic`, G `roughness`, per hit.
+  int32_t metallicRoughnessTexture = -1;
+
+  // SPEC §5: mirror reflection weight metallic × (1 − roughness), from the
+  // factors; with a metallicRoughnessTexture the weight at a hit is
+  // mirrorWeight(metallic · B, roughness · G) (Shader::surfaceAt).
+  static float mirrorWeight(float metallic, float roughness) { return metallic * (1.0f - roughness); }
+  float mirrorWeight() const { return mirrorWeight(metallic, roughness); }
+  // Whether some hit may reflect: the factor weight, or with a texture a
+  // G below 1 (B at most 1 scales metallic down, never up).
+  bool isReflective() const {
+    return mirrorWeight() > 0.0f || (metallicRoughnessTexture >= 0 && metallic > 0.0f);
+  }
+  // A normal, occlusion or metallic-roughness map.
+  bool hasSurfaceMaps() const {
+    return normalTexture >= 0 || occlusionTexture >= 0 || metallicRoughnessTexture >= 0;
+  }
+  // Any texture shading samples.
+  bool isTextured() const { return baseColorTexture >= 0 || emissiveTexture >= 0 || hasSurfaceMaps(); }
   bool isRefractive() const { return transmission > 0.0f; }
   bool isEmissive() const { return emissive != glm::vec3(0.0f); }
 };
@@ -174,6 +207,11 @@ struct Instance {
   uint32_t firstVertex = 0, vertexCount = 0;
   uint32_t firstTriangle = 0, triangleCount = 0;
   uint32_t degenerateCount = 0;  // zero-area triangles (kept, cover nothing)
+  // Tangents (only for instances whose material has a normal map, SPEC §8):
+  // corner k of triangle t (stored order) has Scene::tangents[firstTangent
+  // + 3t + k]. kNoId: none.
+  uint32_t firstTangent = kNoId;
+  bool generatedTangents = false;  // no TANGENT in the file: generated (common/gltf/tangents.h)
 };
 
 // A feature the file uses that the loader checks but nothing renders, with
@@ -236,6 +274,11 @@ struct Scene {
   // no instance has COLOR_0, else parallel to positions and white where an
   // instance has none.
   std::vector<glm::vec4> colors;
+  // Per triangle corner of the instances with a normal map
+  // (Instance::firstTangent): world-space unit tangent xyz and handedness
+  // w = ±1 (glTF: bitangent = cross(normal, xyz) · w). Float, rounded from
+  // the double computation at load.
+  std::vector<glm::vec4> tangents;
   std::vector<glm::uvec3> triangles;  // absolute indices into the vertex arrays
   std::vector<Instance> instances;
 

@@ -55,6 +55,45 @@ glm::vec3 Shader::emission(const SurfacePoint& p, const TextureFootprint& footpr
   return e;
 }
 
+Shader::SurfaceMaps Shader::surfaceMaps(const SurfacePoint& p, const TextureFootprint& footprint) const {
+  const Material& m = *p.material;
+  SurfaceMaps s;
+  s.shadingNormal = p.shadingNormal;
+  s.metallic = m.metallic;
+  s.roughness = m.roughness;
+  if (textures_->empty()) return s;
+  if (m.metallicRoughnessTexture >= 0) {
+    const glm::vec4 texel =
+        textures_->sample(m.metallicRoughnessTexture, p.uv, footprint, options_.textureFilter);
+    s.metallic *= texel.b;  // glTF: metalness in B, roughness in G
+    s.roughness *= texel.g;
+  }
+  if (m.occlusionTexture >= 0) {
+    const float r = textures_->sample(m.occlusionTexture, p.uv, footprint, options_.textureFilter).r;
+    s.occlusion = 1.0f + m.occlusionStrength * (r - 1.0f);
+  }
+  if (m.normalTexture >= 0 && p.tangent != glm::dvec4(0.0)) {
+    const glm::vec4 texel = textures_->sample(m.normalTexture, p.uv, footprint, options_.textureFilter);
+    // glTF: normalize((2·texel − 1) ⊙ (scale, scale, 1)), in double from here.
+    const glm::dvec3 local =
+        glm::dvec3(2.0 * double(texel.r) - 1.0, 2.0 * double(texel.g) - 1.0, 2.0 * double(texel.b) - 1.0) *
+        glm::dvec3(m.normalScale, m.normalScale, 1.0);
+    const glm::dvec3 n = p.shadingNormal;
+    // Gram-Schmidt: the interpolated tangent made perpendicular to n.
+    const glm::dvec3 t = glm::dvec3(p.tangent) - n * glm::dot(n, glm::dvec3(p.tangent));
+    const double tl = glm::length(t);
+    if (tl > 0.0 && std::isfinite(tl)) {
+      const glm::dvec3 tangent = t / tl;
+      const glm::dvec3 bitangent = glm::cross(n, tangent) * p.tangent.w;
+      const glm::dvec3 mapped = tangent * local.x + bitangent * local.y + n * local.z;
+      const double ml = glm::length(mapped);
+      if (ml > 0.0 && std::isfinite(ml))
+        s.shadingNormal = mapped / ml;  // zero (a 0.5 grey texel and scale 0): keep n
+    }
+  }
+  return s;
+}
+
 float Shader::coverageAlpha(const SurfacePoint& p, const TextureFootprint& footprint) const {
   if (p.material->alphaMode == AlphaMode::Opaque) return 1.0f;
   return baseColor(p, footprint).a;
@@ -119,7 +158,10 @@ glm::vec4 Shader::shade(const SurfacePoint& p, const glm::dvec3& direction, cons
   // Lighting uses the side facing the viewer; refraction needs the true
   // orientation to tell entering from leaving.
   const bool entering = isEntering(direction, p.geometricNormal);
-  const glm::dvec3 facing = entering ? p.shadingNormal : -p.shadingNormal;
+  // The maps: normal, metallic-roughness, occlusion (header).
+  const SurfaceMaps maps = m.hasSurfaceMaps() ? surfaceMaps(p, footprint)
+                                              : SurfaceMaps{p.shadingNormal, m.metallic, m.roughness, 1.0f};
+  const glm::dvec3 facing = entering ? maps.shadingNormal : -maps.shadingNormal;
   const glm::dvec3 facingGeometric = entering ? p.geometricNormal : -p.geometricNormal;
   // An interpolated normal may point away from the viewer at silhouettes;
   // fall back to the geometric one there, so no light leaks through.
@@ -127,11 +169,14 @@ glm::vec4 Shader::shade(const SurfacePoint& p, const glm::dvec3& direction, cons
 
   // The weights partition unity (header): the mirror part w first, then the
   // remaining dielectric (1 − w) splits into refraction and diffuse.
-  const float w = m.mirrorWeight();
+  const float w = Material::mirrorWeight(maps.metallic, maps.roughness);
   const float t = (1.0f - w) * m.transmission;
   glm::vec3 L = emission(p, footprint);
   const float diffuseWeight = (1.0f - w) * (1.0f - m.transmission);
-  if (diffuseWeight > 0.0f) L += diffuseWeight * directLight(p, n, direction, c);
+  // Occlusion scales the eye light (the stand-in for ambient light), not a
+  // punctual light's direct term.
+  const glm::vec3 albedo = eyeLight_ ? c * maps.occlusion : c;
+  if (diffuseWeight > 0.0f) L += diffuseWeight * directLight(p, n, direction, albedo);
 
   const bool canTrace = secondary_ && depth < options_.maxDepth;
   if ((w > 0.0f || t > 0.0f) && canTrace) {
@@ -144,7 +189,8 @@ glm::vec4 Shader::shade(const SurfacePoint& p, const glm::dvec3& direction, cons
       // Mirrors tint by the base colour; Fresnel reflection of glass does not.
       const glm::vec3 tint = (w * c + glm::vec3(t * float(F))) / reflectWeight;
       const float weight = reflectWeight * glm::length(tint) / std::sqrt(3.0f);
-      L += reflectWeight * tint *
+      // Reflected light is indirect: the occlusion map scales it.
+      L += reflectWeight * maps.occlusion * tint *
            secondary_->radiance(p, reflected, RayKind::Reflection, depth + 1, throughput * weight);
     }
     if (options_.refraction && t > 0.0f && F < 1.0) {

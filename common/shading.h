@@ -25,6 +25,16 @@
 // C (only the mirror part reflects), so glTF's default material
 // (metallic 1, roughness 1) renders white, not black.
 //
+// The maps (docs/MATERIALS.md), all per hit through the same footprint as
+// the base colour: a normal map replaces n by the tangent-space normal
+// (2·RGB − 1, x and y × scale) in the frame (T, cross(n, T)·w, n); a
+// metallic-roughness map multiplies metallic by B and roughness by G
+// before w is formed; an occlusion map's factor
+// ao = 1 + strength·(R − 1) scales the light that stands for indirect
+// light — the eye light's term and the reflected radiance L_reflect (w and
+// Fresnel parts) — and never a punctual light's direct term, emission or
+// refraction (glTF: occlusion applies to indirect lighting only).
+//
 // A surface's layer colour is premultiplied: (L·α, α), with α the base
 // colour alpha for BLEND materials and 1 otherwise; MASK coverage is the
 // renderer's decision (alpha >= cutoff), made with `coverageAlpha`.
@@ -106,6 +116,15 @@ class Shader {
   // Emitted linear RGB (emissive × emissive texture) at a point; the
   // texture is filtered through the same footprint as the base colour's.
   glm::vec3 emission(const SurfacePoint& point, const TextureFootprint& footprint) const;
+  // The material's maps at a point (docs/MATERIALS.md): the shading normal
+  // (normal map), metallic and roughness (factor × texel) and the
+  // occlusion factor; the plain material's values where it has no maps.
+  struct SurfaceMaps {
+    glm::dvec3 shadingNormal{0.0, 0.0, 1.0};
+    float metallic = 0.0f, roughness = 1.0f;
+    float occlusion = 1.0f;
+  };
+  SurfaceMaps surfaceMaps(const SurfacePoint& point, const TextureFootprint& footprint) const;
   // The alpha a renderer uses for MASK and BLEND coverage decisions.
   float coverageAlpha(const SurfacePoint& point, const TextureFootprint& footprint) const;
 

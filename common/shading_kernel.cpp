@@ -399,13 +399,17 @@ namespace {
 // renderer alike.
 bool needsScalarShade(const Shader& shader, const Material& m) {
   if (m.alphaMode == AlphaMode::Blend) return true;
+  // Normal, occlusion and metallic-roughness maps: the lanes do not read
+  // them (per-hit normal, mirror weight and occlusion), Shader::shade does.
+  if (m.hasSurfaceMaps()) return true;
   const bool canTrace = shader.secondary() && 0 < shader.options().maxDepth;
   return canTrace && (m.mirrorWeight() > 0.0f || (1.0f - m.mirrorWeight()) * m.transmission > 0.0f);
 }
 
 bool samplesTexture(const Shader& shader, const Material& m) {
   if (shader.textures().empty()) return false;
-  return m.baseColorTexture >= 0 || (m.emissiveTexture >= 0 && m.emissive != glm::vec3(0.0f));
+  return m.baseColorTexture >= 0 || (m.emissiveTexture >= 0 && m.emissive != glm::vec3(0.0f)) ||
+         m.hasSurfaceMaps();
 }
 
 // The footprint only where a texture is sampled: elsewhere it is unused.

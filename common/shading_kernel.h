@@ -34,7 +34,9 @@
 //                            secondary rays (mirror weight or transmission
 //                            > 0, a SecondaryRayTracer, depth 0 < maxDepth)
 //                            or is BLEND (layers keep the scalar path in
-//                            both renderers), or when
+//                            both renderers), or has a normal, occlusion
+//                            or metallic-roughness map (docs/MATERIALS.md),
+//                            or when
 //                            ShadingOptions::referenceShading is set.
 //
 // Invariants:

@@ -123,6 +123,15 @@ SurfacePoint surfacePointAt(const Scene& scene, uint32_t instance, uint32_t tria
     sp.uv = float(b0) * scene.texcoords[t.x] + b1 * scene.texcoords[t.y] + b2 * scene.texcoords[t.z];
   if (inst.hasColors)
     sp.color = float(b0) * scene.colors[t.x] + b1 * scene.colors[t.y] + b2 * scene.colors[t.z];
+  if (inst.firstTangent != kNoId) {
+    const glm::vec4* c = &scene.tangents[size_t(inst.firstTangent) + 3 * size_t(triangle)];
+    const glm::dvec3 xyz =
+        b0 * glm::dvec3(c[0]) + double(b1) * glm::dvec3(c[1]) + double(b2) * glm::dvec3(c[2]);
+    // Handedness: the corners' (one value per face when generated), by the
+    // weighted majority where a file's corners disagree.
+    const double w = b0 * c[0].w + double(b1) * c[1].w + double(b2) * c[2].w;
+    sp.tangent = glm::dvec4(xyz, w < 0.0 ? -1.0 : 1.0);
+  }
   return sp;
 }
 

@@ -29,6 +29,11 @@ struct SurfacePoint {
   // white where the instance has none. Shading multiplies it into the
   // base colour (glTF: factor × texture × COLOR_0).
   glm::vec4 color{1.0f};
+  // The tangent frame of a normal-mapped instance (Instance::firstTangent):
+  // the corners' world tangents interpolated (not normalised; the shader
+  // orthogonalises against the shading normal) in xyz, handedness ±1 in w.
+  // Zero where the instance has no tangents.
+  glm::dvec4 tangent{0.0};
 };
 
 SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit);

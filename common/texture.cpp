@@ -1,6 +1,7 @@
 #include "common/texture.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "common/image.h"
@@ -24,7 +25,9 @@ const char* toString(TextureFilter filter) {
 
 namespace {
 
-MipLevel decodeLevel0(const TextureImage& image) {
+// `data`: a normal, occlusion or metallic-roughness map: bytes / 255,
+// opaque (alpha carries nothing there, and must not weigh the filtering).
+MipLevel decodeLevel0(const TextureImage& image, bool data) {
   MipLevel level;
   level.width = image.width;
   level.height = image.height;
@@ -33,6 +36,10 @@ MipLevel decodeLevel0(const TextureImage& image) {
   for (int i = 0; i < 256; ++i) lut[i] = srgbToLinear(i / 255.0f);
   for (size_t i = 0; i < level.texels.size(); ++i) {
     const uint8_t* p = &image.rgba8[i * 4];
+    if (data) {
+      level.texels[i] = glm::vec4(p[0] / 255.0f, p[1] / 255.0f, p[2] / 255.0f, 1.0f);
+      continue;
+    }
     const float a = p[3] / 255.0f;  // alpha is linear in glTF
     level.texels[i] = glm::vec4(lut[p[0]] * a, lut[p[1]] * a, lut[p[2]] * a, a);
   }
@@ -100,24 +107,29 @@ TextureSet::TextureSet(const Scene& scene) {
   chains_.resize(scene.textures.size());
   samplers_.resize(scene.textures.size());
   transforms_.resize(scene.textures.size());
-  std::vector<std::shared_ptr<const std::vector<MipLevel>>> byImage(scene.images.size());
+  // Per image, its colour chain [0] and its data chain [1].
+  std::vector<std::array<std::shared_ptr<const std::vector<MipLevel>>, 2>> byImage(scene.images.size());
   // Base colour and emissive textures are both sRGB colour: one chain
-  // serves a texture used as either, and every texture of its image.
+  // serves a texture used as either, and every texture of its image; the
+  // data maps (Texture::data) share the image's linear chain.
   for (const Material& m : scene.materials)
-    for (const int32_t texture : {m.baseColorTexture, m.emissiveTexture}) {
+    for (const int32_t texture : {m.baseColorTexture, m.emissiveTexture, m.normalTexture, m.occlusionTexture,
+                                  m.metallicRoughnessTexture}) {
       if (texture < 0) continue;
       const size_t t = size_t(texture);
       samplers_[t] = scene.textures[t].sampler;
       transforms_[t] = scene.textures[t].transform;
       if (chains_[t]) continue;
       const size_t image = size_t(scene.textures[t].image);
-      if (!byImage[image]) {
+      const bool data = scene.textures[t].data;
+      auto& shared = byImage[image][data ? 1 : 0];
+      if (!shared) {
         std::vector<MipLevel> chain;
-        chain.push_back(decodeLevel0(scene.images[image]));
+        chain.push_back(decodeLevel0(scene.images[image], data));
         while (chain.back().width > 1 || chain.back().height > 1) chain.push_back(halve(chain.back()));
-        byImage[image] = std::make_shared<const std::vector<MipLevel>>(std::move(chain));
+        shared = std::make_shared<const std::vector<MipLevel>>(std::move(chain));
       }
-      chains_[t] = byImage[image];
+      chains_[t] = shared;
     }
 }
 

@@ -1,5 +1,6 @@
-// Base colour and emissive textures: sRGB decoding, mip chains and
-// filtered lookups, shared by both renderers.
+// Textures: sRGB decoding (base colour, emissive) or linear reading (the
+// data maps: normal, occlusion, metallic-roughness; Texture::data), mip
+// chains and filtered lookups, shared by both renderers.
 //
 // Mip chains are built in linear, premultiplied float RGBA (so filtering
 // neither darkens nor fringes at alpha edges: a transparent texel adds no

@@ -30,7 +30,7 @@ MaterialCounts countMaterials(const Scene& scene) {
     c.reflective += m.isReflective();
     c.refractive += m.isRefractive();
     c.emissive += m.isEmissive();
-    c.textured += m.baseColorTexture >= 0 || m.emissiveTexture >= 0;
+    c.textured += m.isTextured();
     c.doubleSided += m.doubleSided;
   }
   return c;
@@ -182,6 +182,10 @@ nlohmann::json sceneInfoJson(const Scene& scene, const CameraOptions& options) {
                     {"mirrored", in.mirrored},
                     {"normals", in.normals == NormalSource::Authored ? "authored" : "flat"},
                     {"vertexColors", in.hasColors},
+                    // Normal-map tangents: stored only for instances whose material has a normal map.
+                    {"tangents", in.firstTangent == kNoId ? "none"
+                                 : in.generatedTangents   ? "generated"
+                                                          : "file"},
                     {"skinned", in.skinned},
                     {"morphed", in.morphed}});
   }

@@ -116,6 +116,8 @@ void makeOpaqueDiffuse(Scene& scene) {
     m.transmission = 0.0f;
     m.emissive = glm::vec3(0.0f);
     m.emissiveTexture = -1;
+    // The maps would tilt normals and move the mirror weight: diffuse means flat.
+    m.normalTexture = m.occlusionTexture = m.metallicRoughnessTexture = -1;
   }
 }
 

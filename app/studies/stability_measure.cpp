@@ -100,7 +100,7 @@ struct DoubleTriangle {
 
 bool diffuseOnly(const Scene& scene, uint32_t instance) {
   const Material& m = scene.materialOf(instance);
-  return m.mirrorWeight() == 0.0f && m.transmission == 0.0f && m.baseColorTexture < 0 && !m.isEmissive() &&
+  return !m.isReflective() && m.transmission == 0.0f && !m.isTextured() && !m.isEmissive() &&
          m.alphaMode == AlphaMode::Opaque && !scene.instanceOf(instance).hasColors;
 }
 

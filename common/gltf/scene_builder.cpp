@@ -21,6 +21,7 @@
 #include "common/gltf/check.h"
 #include "common/gltf/compression.h"
 #include "common/gltf/document.h"
+#include "common/gltf/tangents.h"
 #include "common/math_constants.h"
 #include "common/memory_budget.h"
 
@@ -33,6 +34,7 @@ using json = nlohmann::json;
 // The KHR_texture_transform object of a textureInfo, or nullptr.
 const json* textureTransformOf(const json& textureInfo);
 int64_t texCoordOf(const json& textureInfo);
+int64_t materialTexCoordSet(const json& material);
 
 class SceneBuilder {
  public:
@@ -83,6 +85,9 @@ class SceneBuilder {
     size_t count = 0;                                   // vertices
     std::vector<double> positions, normals, texcoords;  // object space; normals, texcoords may be empty
     std::vector<glm::vec4> colors;                      // empty without COLOR_0
+    bool needsTangents = false;                         // the material has a normal map
+    std::vector<double> tangents;   // TANGENT (4 per vertex), object space; empty: generate
+    std::vector<glm::dmat3> skins;  // per vertex, the blended joint matrix (skinned, needsTangents)
   };
   // Adds the weighted POSITION and NORMAL deltas of the primitive's
   // morph targets to `v`; returns whether any weight was nonzero.
@@ -96,7 +101,17 @@ class SceneBuilder {
   int64_t texCoordSetOf(const json& prim) const;
   VertexData readVertexData(const json& prim, const std::string& e, Instance& inst) const;
   void appendVertices(Instance& inst, const VertexData& v, const glm::dmat4& world, const std::string& e);
-  void appendTriangles(Instance& inst, const json& prim, const std::string& e);
+  // The primitive's triangles (SPEC §1), vertex indices local to it, in
+  // the file's winding.
+  std::vector<glm::uvec3> triangulate(const json& prim, const std::string& e, size_t vertexCount) const;
+  void appendTriangles(Instance& inst, const std::vector<glm::uvec3>& triangles);
+  // Per corner of `triangles`, object space: the file's TANGENT, else
+  // generated (common/gltf/tangents.h).
+  std::vector<glm::dvec4> objectTangents(const VertexData& v, const std::vector<glm::uvec3>& triangles) const;
+  // Corner tangents into world space (by the world matrix, or by each
+  // vertex's skin matrix) and into Scene::tangents, in stored order.
+  void appendTangents(Instance& inst, const VertexData& v, const std::vector<glm::uvec3>& triangles,
+                      const std::vector<glm::dvec4>& corners, const glm::dmat4& world);
   void addCamera(size_t node, const glm::dmat4& world);
   void addLight(size_t node, const glm::dmat4& world);
   void loadMaterials();
@@ -107,7 +122,9 @@ class SceneBuilder {
   void noteIgnoredExtensions(const json& value, std::vector<std::string>& path);
   // The texture a textureInfo names, or -1 when its texture has no image
   // we could decode (e.g. only a KTX2 source through an extension).
-  int32_t decodableTexture(const json& textureInfo);
+  // `data`: a normal, occlusion or metallic-roughness map (Texture::data),
+  // which gets a Texture of its own.
+  int32_t decodableTexture(const json& textureInfo, bool data = false);
   std::vector<glm::vec4> readColors(const json& attributes, const std::string& element,
                                     size_t vertexCount) const;
 
@@ -616,6 +633,7 @@ void SceneBuilder::reserveFlattenedScene(const std::vector<size_t>& roots) {
   const json& accessors = array("accessors");
   struct MeshTotals {
     uint64_t vertices = 0, triangles = 0, primitives = 0, largestPrimitive = 0;
+    uint64_t tangentCorners = 0;  // 3 per triangle of a primitive with a normal map
     bool colors = false, counted = false;
   };
   std::vector<MeshTotals> meshes(array("meshes").size());
@@ -632,14 +650,17 @@ void SceneBuilder::reserveFlattenedScene(const std::vector<size_t>& roots) {
                              ? accessors[prim.at("indices").get<size_t>()].at("count").get<uint64_t>()
                              : v;
       t.vertices += v;
-      t.triangles += mode == 4 ? n / 3 : (n >= 3 ? n - 2 : 0);
+      const uint64_t tris = mode == 4 ? n / 3 : (n >= 3 ? n - 2 : 0);
+      t.triangles += tris;
+      if (prim.contains("material") && scene_.materials[prim.at("material").get<size_t>()].normalTexture >= 0)
+        t.tangentCorners += 3 * tris;
       t.primitives += 1;
       t.largestPrimitive = std::max(t.largestPrimitive, std::max(v, n));
       t.colors = t.colors || attributes.contains("COLOR_0");
     }
     return t;
   };
-  uint64_t vertices = 0, triangles = 0, instances = 0, largestPrimitive = 0;
+  uint64_t vertices = 0, triangles = 0, instances = 0, largestPrimitive = 0, tangentCorners = 0;
   bool colors = false;
   std::vector<size_t> stack(roots.rbegin(), roots.rend());
   while (!stack.empty()) {
@@ -649,6 +670,7 @@ void SceneBuilder::reserveFlattenedScene(const std::vector<size_t>& roots) {
       const MeshTotals& t = totalsOf(n.at("mesh").get<size_t>());
       vertices = addSat(vertices, t.vertices);
       triangles = addSat(triangles, t.triangles);
+      tangentCorners = addSat(tangentCorners, t.tangentCorners);
       instances = addSat(instances, t.primitives);
       largestPrimitive = std::max(largestPrimitive, t.largestPrimitive);
       colors = colors || t.colors;
@@ -673,6 +695,8 @@ void SceneBuilder::reserveFlattenedScene(const std::vector<size_t>& roots) {
   estimate.add("loaded file", currentRssBytes());
   estimate.add("vertices", mulSat(vertices, perVertex));
   estimate.add("triangles", mulSat(triangles, sizeof(glm::uvec3)));
+  // Only primitives with a normal map carry tangents (SPEC §8).
+  if (tangentCorners > 0) estimate.add("tangents", mulSat(tangentCorners, sizeof(glm::vec4)));
   estimate.add("instances", mulSat(instances, sizeof(Instance)));
   estimate.add("largest primitive", mulSat(largestPrimitive, 8 * sizeof(double) + sizeof(uint32_t)));
   checkMemory(estimate, budget_, path_, "scene",
@@ -685,6 +709,7 @@ void SceneBuilder::reserveFlattenedScene(const std::vector<size_t>& roots) {
   scene_.texcoords.reserve(vertices);
   if (colors) scene_.colors.reserve(vertices);
   scene_.triangles.reserve(triangles);
+  scene_.tangents.reserve(tangentCorners);
   scene_.instances.reserve(instances);
 }
 
@@ -762,18 +787,27 @@ void SceneBuilder::addPrimitive(size_t node, size_t mesh, size_t primitive, cons
   VertexData vertices = readVertexData(prim, e, inst);
   if (prim.contains("targets"))
     inst.morphed = applyMorphTargets(prim, e, morphWeights(node, mesh, prim.at("targets").size()), vertices);
+  const std::vector<glm::uvec3> triangles = triangulate(prim, e, vertices.count);
+  // Tangents on the (morphed) object-space mesh, before the skin or the
+  // world matrix moves it: the space normal maps are baked in.
+  std::vector<glm::dvec4> tangents;
+  if (vertices.needsTangents) {
+    inst.generatedTangents = vertices.tangents.empty();
+    tangents = objectTangents(vertices, triangles);
+  }
   const json& n = array("nodes")[node];
+  glm::dmat4 placement = world;
   if (n.contains("skin") && attributes.contains("JOINTS_0") && attributes.contains("WEIGHTS_0")) {
     // The skin places the vertices in world space; the node's own
     // transform is ignored (glTF 2.0 §3.7.3.3).
     inst.skinned = true;
     inst.worldFromObject = glm::dmat4(1.0);
+    placement = glm::dmat4(1.0);
     inst.mirrored = applySkin(prim, e, n.at("skin").get<size_t>(), vertices);
-    appendVertices(inst, vertices, glm::dmat4(1.0), e);
-  } else {
-    appendVertices(inst, vertices, world, e);
   }
-  appendTriangles(inst, prim, e);
+  appendVertices(inst, vertices, placement, e);
+  appendTriangles(inst, triangles);
+  if (!tangents.empty()) appendTangents(inst, vertices, triangles, tangents, placement);
   dracoAccessors_.clear();
   scene_.instances.push_back(inst);
 }
@@ -795,10 +829,20 @@ uint32_t SceneBuilder::materialOf(const json& prim) {
 // drops an emissive texture that names another set than the base colour.
 int64_t SceneBuilder::texCoordSetOf(const json& prim) const {
   if (!prim.contains("material")) return 0;
-  const json& m = array("materials")[prim.at("material").get<size_t>()];
-  if (m.contains("pbrMetallicRoughness") && m.at("pbrMetallicRoughness").contains("baseColorTexture"))
-    return texCoordOf(m.at("pbrMetallicRoughness").at("baseColorTexture"));
+  return materialTexCoordSet(array("materials")[prim.at("material").get<size_t>()]);
+}
+
+// The one uv set a material's textures are read through (Scene::texcoords):
+// the first of its textureInfos, in the order base colour, emissive,
+// metallic-roughness, normal, occlusion; 0 without any.
+int64_t materialTexCoordSet(const json& m) {
+  const json* pbr = m.contains("pbrMetallicRoughness") ? &m.at("pbrMetallicRoughness") : nullptr;
+  if (pbr && pbr->contains("baseColorTexture")) return texCoordOf(pbr->at("baseColorTexture"));
   if (m.contains("emissiveTexture")) return texCoordOf(m.at("emissiveTexture"));
+  if (pbr && pbr->contains("metallicRoughnessTexture"))
+    return texCoordOf(pbr->at("metallicRoughnessTexture"));
+  if (m.contains("normalTexture")) return texCoordOf(m.at("normalTexture"));
+  if (m.contains("occlusionTexture")) return texCoordOf(m.at("occlusionTexture"));
   return 0;
 }
 
@@ -843,6 +887,22 @@ SceneBuilder::VertexData SceneBuilder::readVertexData(const json& prim, const st
   }
   v.colors = readColors(attributes, e, v.count);
   inst.hasColors = !v.colors.empty();
+  v.needsTangents = scene_.materials[inst.material].normalTexture >= 0;
+  if (v.needsTangents && attributes.contains("TANGENT")) {
+    // glTF 2.0 §3.7.2.1: VEC4 float, or normalized signed byte/short; xyz
+    // unit, w = ±1 (its sign is read).
+    const int64_t ta = attributes.at("TANGENT").get<int64_t>();
+    const json& a = array("accessors")[size_t(ta)];
+    const std::string te = e + " TANGENT (accessor " + std::to_string(ta) + ")";
+    const int64_t ct = a.at("componentType").get<int64_t>();
+    if (!(ct == 5126 || ((ct == 5120 || ct == 5122) && get(a, "normalized", false))))
+      fail(te, "componentType " + std::to_string(ct) +
+                   " must be 5126, or 5120 or 5122 with \"normalized\": true");
+    v.tangents = readAccessor(ta, e + " TANGENT", {"VEC4"}, &components);
+    if (v.tangents.size() / 4 != v.count)
+      fail(te,
+           "has " + std::to_string(v.tangents.size() / 4) + " elements, POSITION " + std::to_string(v.count));
+  }
   return v;
 }
 
@@ -895,16 +955,19 @@ bool SceneBuilder::applyMorphTargets(const json& prim, const std::string& e,
     if (weights[t] == 0.0) continue;
     any = true;
     const std::string te = e + " target " + std::to_string(t);
-    for (const char* attribute : {"POSITION", "NORMAL"}) {
-      std::vector<double>& base = attribute[0] == 'P' ? v.positions : v.normals;
-      if (!targets[t].contains(attribute) || base.empty()) continue;  // no NORMAL to move: face normals
+    for (const char* attribute : {"POSITION", "NORMAL", "TANGENT"}) {
+      const char kind = attribute[0];
+      std::vector<double>& base = kind == 'P' ? v.positions : kind == 'N' ? v.normals : v.tangents;
+      // No NORMAL to move: face normals; no TANGENT read: none needed, or generated from the morphed mesh.
+      if (!targets[t].contains(attribute) || base.empty()) continue;
       size_t components = 0;
       const std::vector<double> delta =
           readAccessor(targets[t].at(attribute).get<int64_t>(), te + " " + attribute, {"VEC3"}, &components);
-      if (delta.size() != base.size())
+      const size_t width = kind == 'T' ? 4 : 3;  // a TANGENT delta moves xyz, not w
+      if (delta.size() / 3 != base.size() / width)
         fail(te, std::string(attribute) + " has " + std::to_string(delta.size() / 3) +
                      " elements, the primitive " + std::to_string(v.count) + " vertices");
-      for (size_t i = 0; i < base.size(); ++i) base[i] += weights[t] * delta[i];
+      for (size_t i = 0; i < delta.size(); ++i) base[i / 3 * width + i % 3] += weights[t] * delta[i];
     }
   }
   return any;
@@ -967,6 +1030,8 @@ bool SceneBuilder::applySkin(const json& prim, const std::string& e, size_t skin
     const glm::dmat3 m3(m);
     const double det = glm::determinant(m3);
     mirroring += det < 0.0;
+    // Tangents are directions on the surface: they move by m3 itself.
+    if (v.needsTangents) v.skins.push_back(m3);
     if (!v.normals.empty()) {
       // The inverse transpose, as the cofactor matrix (defined when m3 is
       // singular; its sign kept by det), renormalised.
@@ -983,8 +1048,8 @@ bool SceneBuilder::applySkin(const json& prim, const std::string& e, size_t skin
 
 // Triangulates (SPEC §1) the primitive's indices, or its vertices in order
 // when it has none, into Scene::triangles.
-void SceneBuilder::appendTriangles(Instance& inst, const json& prim, const std::string& e) {
-  const size_t vertexCount = inst.vertexCount;
+std::vector<glm::uvec3> SceneBuilder::triangulate(const json& prim, const std::string& e,
+                                                  size_t vertexCount) const {
   std::vector<uint32_t> indices;
   if (prim.contains("indices")) {
     const int64_t ia = prim.at("indices").get<int64_t>();
@@ -999,12 +1064,13 @@ void SceneBuilder::appendTriangles(Instance& inst, const json& prim, const std::
   }
   const size_t n = indices.size();
   std::vector<glm::uvec3> tris;
-  if (inst.mode == 4) {
+  const int64_t mode = get<int64_t>(prim, "mode", 4);
+  if (mode == 4) {
     if (n % 3 != 0)
       fail(e, std::to_string(n) + (prim.contains("indices") ? " indices" : " vertices") +
                   " for TRIANGLES is not a multiple of 3");
     for (size_t i = 0; i + 2 < n; i += 3) tris.emplace_back(indices[i], indices[i + 1], indices[i + 2]);
-  } else if (inst.mode == 5) {
+  } else if (mode == 5) {
     for (size_t i = 0; i + 2 < n; ++i)
       tris.push_back(i % 2 == 0 ? glm::uvec3(indices[i], indices[i + 1], indices[i + 2])
                                 : glm::uvec3(indices[i + 1], indices[i], indices[i + 2]));
@@ -1013,6 +1079,10 @@ void SceneBuilder::appendTriangles(Instance& inst, const json& prim, const std::
   }
   if (scene_.triangles.size() + tris.size() >= size_t(kNoId))
     fail(e, "the scene has more than 2^32 triangles");
+  return tris;
+}
+
+void SceneBuilder::appendTriangles(Instance& inst, const std::vector<glm::uvec3>& tris) {
   for (glm::uvec3 t : tris) {
     if (inst.mirrored) std::swap(t.y, t.z);  // keep CCW = front in world space
     t += glm::uvec3(inst.firstVertex);
@@ -1020,6 +1090,53 @@ void SceneBuilder::appendTriangles(Instance& inst, const json& prim, const std::
     if (isDegenerate(scene_, scene_.triangles.size() - 1)) ++inst.degenerateCount;
   }
   inst.triangleCount = uint32_t(tris.size());
+}
+
+std::vector<glm::dvec4> SceneBuilder::objectTangents(const VertexData& v,
+                                                     const std::vector<glm::uvec3>& triangles) const {
+  if (!v.tangents.empty()) {
+    std::vector<glm::dvec4> out;
+    out.reserve(3 * triangles.size());
+    for (const glm::uvec3& t : triangles)
+      for (int k = 0; k < 3; ++k) {
+        const double* x = &v.tangents[4 * size_t(t[k])];
+        out.emplace_back(x[0], x[1], x[2], x[3] < 0.0 ? -1.0 : 1.0);
+      }
+    return out;
+  }
+  std::vector<glm::dvec3> positions(v.count), normals(v.normals.empty() ? 0 : v.count);
+  std::vector<glm::dvec2> uvs(v.texcoords.empty() ? 0 : v.count);
+  for (size_t i = 0; i < v.count; ++i) {
+    positions[i] = glm::dvec3(v.positions[3 * i], v.positions[3 * i + 1], v.positions[3 * i + 2]);
+    if (!normals.empty())
+      normals[i] = glm::dvec3(v.normals[3 * i], v.normals[3 * i + 1], v.normals[3 * i + 2]);
+    if (!uvs.empty()) uvs[i] = glm::dvec2(v.texcoords[2 * i], v.texcoords[2 * i + 1]);
+  }
+  return generateTangents(positions, normals, uvs, triangles);
+}
+
+void SceneBuilder::appendTangents(Instance& inst, const VertexData& v,
+                                  const std::vector<glm::uvec3>& triangles,
+                                  const std::vector<glm::dvec4>& corners, const glm::dmat4& world) {
+  inst.firstTangent = uint32_t(scene_.tangents.size());
+  const glm::dmat3 m3(world);
+  for (size_t f = 0; f < triangles.size(); ++f) {
+    glm::vec4 stored[3];
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec4 t = corners[3 * f + size_t(k)];
+      const glm::dmat3& m = v.skins.empty() ? m3 : v.skins[triangles[f][k]];
+      glm::dvec3 xyz = m * glm::dvec3(t);
+      const double length = glm::length(xyz);
+      xyz =
+          length > 0.0 && std::isfinite(length) ? xyz / length : glm::dvec3(0.0);  // zero: no normal map here
+      // A mirroring matrix turns the frame's handedness (the normal follows
+      // the cofactor, appendVertices): the bitangent keeps its side.
+      const double w = glm::determinant(m) < 0.0 ? -t.w : t.w;
+      stored[k] = glm::vec4(glm::vec3(xyz), float(w));
+    }
+    if (inst.mirrored) std::swap(stored[1], stored[2]);  // as appendTriangles swapped the corners
+    scene_.tangents.insert(scene_.tangents.end(), stored, stored + 3);
+  }
 }
 
 void SceneBuilder::addCamera(size_t node, const glm::dmat4& world) {
@@ -1163,6 +1280,25 @@ void SceneBuilder::loadMaterials() {
       mat.metallic = unit(get(pbr, "metallicFactor", 1.0), "metallicFactor");
       mat.roughness = unit(get(pbr, "roughnessFactor", 1.0), "roughnessFactor");
     }
+    // The data maps, each through the material's one uv set (Scene::texcoords).
+    const int64_t set = materialTexCoordSet(m);
+    auto dataMap = [&](const json& owner, const char* key, const std::string& feature) {
+      if (!owner.contains(key)) return int32_t(-1);
+      if (texCoordOf(owner.at(key)) != set) {
+        noteIgnored(feature + " texture on another texCoord set than the base colour texture", "material");
+        return int32_t(-1);
+      }
+      return decodableTexture(owner.at(key), true);
+    };
+    if (m.contains("pbrMetallicRoughness"))
+      mat.metallicRoughnessTexture =
+          dataMap(m.at("pbrMetallicRoughness"), "metallicRoughnessTexture", "metallicRoughness");
+    mat.normalTexture = dataMap(m, "normalTexture", "normal");
+    if (mat.normalTexture >= 0) mat.normalScale = float(get(m.at("normalTexture"), "scale", 1.0));
+    mat.occlusionTexture = dataMap(m, "occlusionTexture", "occlusion");
+    if (mat.occlusionTexture >= 0)
+      mat.occlusionStrength =
+          unit(get(m.at("occlusionTexture"), "strength", 1.0), "occlusionTexture strength");
     glm::dvec3 emissive(0.0);
     if (m.contains("emissiveFactor")) {
       const auto f = m.at("emissiveFactor").get<std::vector<double>>();
@@ -1207,23 +1343,25 @@ void SceneBuilder::loadMaterials() {
   }
 }
 
-int32_t SceneBuilder::decodableTexture(const json& textureInfo) {
+int32_t SceneBuilder::decodableTexture(const json& textureInfo, bool data) {
   const int32_t tex = textureInfo.at("index").get<int32_t>();
   if (scene_.textures[size_t(tex)].image < 0) {
     noteIgnored("texture without a decodable image", "textureInfo");
     return -1;
   }
-  const json* transform = textureTransformOf(textureInfo);
-  if (!transform) return tex;
-  // KHR_texture_transform: a texture of this textureInfo's own, sharing
-  // the image (and its mip chain, TextureSet) and the sampler.
-  const auto pair = [&](const char* key, double fallback) {
-    const auto v = get<std::vector<double>>(*transform, key, {fallback, fallback});
-    return glm::dvec2(v[0], v[1]);
-  };
+  // KHR_texture_transform and data maps (read linearly) get a texture of
+  // this textureInfo's own, sharing the image (its chain of that kind,
+  // TextureSet) and the sampler.
   Texture t = scene_.textures[size_t(tex)];
-  t.transform = TextureTransform(pair("offset", 0.0), get(*transform, "rotation", 0.0), pair("scale", 1.0));
-  if (t.transform.identity) return tex;
+  t.data = data;
+  if (const json* transform = textureTransformOf(textureInfo)) {
+    const auto pair = [&](const char* key, double fallback) {
+      const auto v = get<std::vector<double>>(*transform, key, {fallback, fallback});
+      return glm::dvec2(v[0], v[1]);
+    };
+    t.transform = TextureTransform(pair("offset", 0.0), get(*transform, "rotation", 0.0), pair("scale", 1.0));
+  }
+  if (!data && t.transform.identity) return tex;
   scene_.textures.push_back(t);
   return int32_t(scene_.textures.size() - 1);
 }
@@ -1265,18 +1403,13 @@ void SceneBuilder::noteIgnored(const std::string& feature, const std::string& un
 // elements (every material, primitive, node), used or not.
 void SceneBuilder::noteIgnoredFeatures() {
   for (const json& m : array("materials")) {
-    if (m.contains("normalTexture")) noteIgnored("normal texture", "material");
-    if (m.contains("occlusionTexture")) noteIgnored("occlusion texture", "material");
-    if (m.contains("pbrMetallicRoughness") &&
-        m.at("pbrMetallicRoughness").contains("metallicRoughnessTexture"))
-      noteIgnored("metallicRoughness texture", "material");
     if (m.contains("extensions") && m.at("extensions").contains("KHR_materials_transmission") &&
         m.at("extensions").at("KHR_materials_transmission").contains("transmissionTexture"))
       noteIgnored("transmission texture", "material");
   }
   for (const json& mesh : array("meshes"))
     for (const json& prim : mesh.at("primitives")) {
-      // Morph targets move POSITION and NORMAL (TANGENT is not read).
+      // Morph targets move POSITION, NORMAL and TANGENT.
       if (!prim.contains("targets")) continue;
       bool other = false;
       for (const json& target : prim.at("targets"))

@@ -98,6 +98,11 @@ nlohmann::json buildDocument(const GltfScene& scene, std::vector<unsigned char>&
       attributes["NORMAL"] = floatAccessor(&m.normals[0].x, m.normals.size(), 3, "VEC3", false);
     if (!m.texcoords.empty())
       attributes["TEXCOORD_0"] = floatAccessor(&m.texcoords[0].x, m.texcoords.size(), 2, "VEC2", false);
+    if (!m.tangents.empty()) {
+      if (m.tangents.size() != m.positions.size())
+        throw std::runtime_error("gltf_writer: tangents do not match the positions");
+      attributes["TANGENT"] = floatAccessor(&m.tangents[0].x, m.tangents.size(), 4, "VEC4", false);
+    }
     const size_t indexOffset = bytes.size();
     append(&bytes, m.indices.data(), m.indices.size());
     views.push_back({{"buffer", 0}, {"byteOffset", indexOffset}, {"byteLength", m.indices.size() * 4}});
@@ -130,6 +135,14 @@ nlohmann::json buildDocument(const GltfScene& scene, std::vector<unsigned char>&
         throw std::runtime_error("gltf_writer: material names a texture that does not exist");
       j["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", m.baseColorTexture}, {"texCoord", 0}};
     }
+    for (const int texture : {m.normalTexture, m.occlusionTexture, m.metallicRoughnessTexture})
+      if (texture >= 0 && size_t(texture) >= textures.size())
+        throw std::runtime_error("gltf_writer: material names a texture that does not exist");
+    if (m.normalTexture >= 0) j["normalTexture"] = {{"index", m.normalTexture}, {"scale", m.normalScale}};
+    if (m.occlusionTexture >= 0)
+      j["occlusionTexture"] = {{"index", m.occlusionTexture}, {"strength", m.occlusionStrength}};
+    if (m.metallicRoughnessTexture >= 0)
+      j["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", m.metallicRoughnessTexture}};
     if (m.transmission > 0.0f) {
       transmission = true;
       j["extensions"] = {{"KHR_materials_transmission", {{"transmissionFactor", m.transmission}}},

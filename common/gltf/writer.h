@@ -2,8 +2,9 @@
 // (regression cases, random scenes), of `rastray stability` and of the
 // crossover study. Positions, optional normals and texcoords, and uint32
 // indices in one buffer (a base64 data URI in .gltf, the BIN chunk in
-// .glb); metallic-roughness materials with an optional base colour texture
-// (8-bit RGB, embedded as a data-URI PNG), an emissive factor and
+// .glb); metallic-roughness materials with optional base colour, normal,
+// occlusion and metallic-roughness textures (8-bit RGB, embedded as
+// data-URI PNGs), optional tangents, an emissive factor and
 // KHR_materials_transmission/ior; one optional perspective or orthographic
 // camera (placed by eye/target/up) and KHR_lights_punctual lights.
 #pragma once
@@ -25,6 +26,12 @@ struct GltfMaterial {
   float ior = 1.5f;
   int baseColorTexture = -1;  // index into GltfScene::textures, read through TEXCOORD_0; -1: none
   glm::vec3 emissive{0.0f};   // emissiveFactor, each in [0, 1]; written when not black
+  // The data maps (indices into GltfScene::textures, TEXCOORD_0; -1: none).
+  int normalTexture = -1;
+  float normalScale = 1.0f;
+  int occlusionTexture = -1;
+  float occlusionStrength = 1.0f;
+  int metallicRoughnessTexture = -1;
 };
 
 // An 8-bit RGB image (row 0 at the top, v = 0) with its glTF sampler.
@@ -43,7 +50,8 @@ struct GltfMesh {
   std::vector<glm::vec3> normals;    // empty, or one per position (NORMAL)
   std::vector<glm::vec2> texcoords;  // empty, or one per position (TEXCOORD_0)
   int material = 0;
-  glm::dvec3 translation{0.0};  // the node's translation (kept exact in the file)
+  glm::dvec3 translation{0.0};      // the node's translation (kept exact in the file)
+  std::vector<glm::vec4> tangents;  // empty, or one per position (TANGENT)
 };
 
 struct GltfCamera {

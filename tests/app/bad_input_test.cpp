@@ -89,6 +89,9 @@ const BadInput kBadInputs[] = {
     {"triangles-5-indices.gltf", "mesh 0 primitive 0: 5 indices for TRIANGLES"},
     {"triangles-7-indices.gltf", "mesh 0 primitive 0: 7 indices for TRIANGLES"},
     {"normal-count-mismatch.gltf", "mesh 0 primitive 0: NORMAL has 3 elements, POSITION 4"},
+    {"tangent-nan.gltf", "mesh 0 primitive 0 TANGENT (accessor 3): element 2 component 1 is NaN"},
+    {"tangent-vec3.gltf", "mesh 0 primitive 0 TANGENT (accessor 3): type VEC3 is not allowed here"},
+    {"tangent-count.gltf", "mesh 0 primitive 0 TANGENT (accessor 3): has 3 elements, POSITION 4"},
     {"node-matrix-overflow.gltf", "node 0: invalid JSON at line 30"},
     {"node-world-matrix-overflow.gltf", "node 1: world matrix is not finite"},
     {"node-rotation-zero.gltf", "node 0: \"rotation\" is a zero quaternion"},
@@ -132,6 +135,7 @@ const BadInput kBadInputs[] = {
     {"image-undecodable-file.gltf", "image 0: "},
     {"image-uri-directory.gltf", "image 0: \"valid\" could not be read"},
     {"texture-source-missing.gltf", "texture 0: \"source\" refers to image 3"},
+    {"normal-texture-missing.gltf", "material 0 normalTexture: \"index\" refers to texture 2"},
     {"material-texture-missing.gltf",
      "material 0 pbrMetallicRoughness baseColorTexture: \"index\" refers to texture 1"},
     // Cameras and lights.

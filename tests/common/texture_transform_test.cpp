@@ -148,5 +148,30 @@ TEST(TextureTransform, MalformedTransformIsRefusedNamingTheTextureInfo) {
   }
 }
 
+TEST(TextureTransform, AppliesToTheDataMapsTooWhichReadLinearly) {
+  // tests/data/malformed/generate.py: normal, occlusion and metallic-
+  // roughness textureInfos of one 1×1 image (128, 128, 255), each with the
+  // transform offset (0.5, 0), rotation 0.5, scale (2, 2).
+  const Scene s = loadScene(test::testDataPath("malformed/valid/material-maps-generated-tangents.gltf"));
+  EXPECT_TRUE(s.ignored.empty()) << s.ignored[0].describe();
+  const Material& m = s.materials[0];
+  const TextureTransform expected({0.5, 0.0}, 0.5, {2.0, 2.0});
+  const TextureSet set(s);
+  for (const int32_t t : {m.normalTexture, m.occlusionTexture, m.metallicRoughnessTexture}) {
+    ASSERT_GE(t, 0);
+    EXPECT_TRUE(s.textures[size_t(t)].data);
+    expectNear(s.textures[size_t(t)].transform.apply({0.4f, 0.9f}), expected.apply({0.4f, 0.9f}),
+               "transform");
+    // Linear, not sRGB-decoded: 128/255, not 0.216.
+    const glm::vec4 texel = set.sample(t, {0.3f, 0.3f}, {}, TextureFilter::Nearest);
+    EXPECT_NEAR(texel.r, 128.0f / 255.0f, 1e-6f);
+    EXPECT_NEAR(texel.b, 1.0f, 1e-6f);
+  }
+  EXPECT_EQ(m.normalScale, 0.5f);
+  EXPECT_EQ(m.occlusionStrength, 0.5f);
+  // The three share the image's one linear chain.
+  EXPECT_EQ(&set.levels(m.normalTexture), &set.levels(m.occlusionTexture));
+}
+
 }  // namespace
 }  // namespace rastray

@@ -20,6 +20,7 @@ import base64
 import json
 import os
 import struct
+import zlib
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -160,6 +161,32 @@ def skinned_quad(joints):
                             "indices": idx}]}
     return b.gltf([mesh], [{"mesh": 0, "skin": 0}, {}, {}], scenes=[{"nodes": [0, 1, 2]}], scene=0,
                   skins=[{"joints": joints}])
+
+
+def png_1x1():
+    """A valid 1x1 RGB PNG (the flat normal (128, 128, 255))."""
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+    header = struct.pack(">IIBBBBB", 1, 1, 8, 2, 0, 0, 0)
+    pixels = zlib.compress(b"\x00\x80\x80\xff")
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", pixels) + chunk(b"IEND", b"")
+
+
+def normal_mapped_quad(tangents, type_):
+    """quad_doc with a normal-mapped material, TEXCOORD_0 and a TANGENT
+    (accessor 3) of the given values and type; TEXCOORD_0 is accessor 4."""
+    b = Builder()
+    pos = b.positions(QUAD)
+    nrm = b.vec3([(0, 0, 1)] * 4)
+    idx = b.indices([0, 1, 2, 0, 2, 3])
+    tan = b.accessor(tangents, FLOAT, type_)
+    uv = b.vec2([(0, 1), (1, 1), (1, 0), (0, 0)])
+    attributes = {"POSITION": pos, "NORMAL": nrm, "TANGENT": tan, "TEXCOORD_0": uv}
+    mesh = {"primitives": [{"attributes": attributes, "indices": idx, "material": 0}]}
+    return b.gltf([mesh], [{"mesh": 0}], scenes=[{"nodes": [0]}], scene=0,
+                  materials=[{"normalTexture": {"index": 0}}], textures=[{"source": 0}],
+                  images=[{"uri": "data:image/png;base64," + base64.b64encode(png_1x1()).decode()}])
 
 
 def text(doc):
@@ -491,6 +518,20 @@ def malformed():
         extensionsUsed=["KHR_lights_punctual"],
         extensions={"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": -1.0}]}}))
 
+    # Normal maps: the TANGENT a normal-mapped primitive is read with.
+    for name, values, type_, count in (
+            ("tangent-nan.gltf", [1, 0, 0, 1] * 2 + [1, float("nan"), 0, 1] + [1, 0, 0, 1], "VEC4", None),
+            ("tangent-vec3.gltf", [1, 0, 0] * 4, "VEC3", None),
+            ("tangent-count.gltf", [1, 0, 0, 1] * 4, "VEC4", 3)):
+        d = normal_mapped_quad(values, type_)
+        if count is not None:
+            d["accessors"][3]["count"] = count
+        files[name] = text(d)
+    d = quad_doc(materials=[{"normalTexture": {"index": 2}}], textures=[{"source": 0}],
+                 images=[{"uri": "data:image/png;base64," + base64.b64encode(png_1x1()).decode()}])
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    files["normal-texture-missing.gltf"] = text(d)
+
     # References to elements that do not exist.
     d = quad_doc()
     d["nodes"][0]["mesh"] = 5
@@ -650,6 +691,39 @@ def valid():
     mesh = triangle_mesh(b, [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 1), (2, 2, 2)],
                          indices=[0, 1, 2, 0, 3, 4, 1, 1, 2])
     files["degenerate.gltf"] = text(b.gltf([mesh], [{"mesh": 0}], scenes=[{"nodes": [0]}]))
+
+    # Material maps: a quad with file tangents, and one without (generated)
+    # whose normal, occlusion and metallic-roughness maps are transformed.
+    files["normal-mapped.gltf"] = text(normal_mapped_quad([1, 0, 0, 1] * 4, "VEC4"))
+    d = normal_mapped_quad([1, 0, 0, 1] * 4, "VEC4")
+    del d["meshes"][0]["primitives"][0]["attributes"]["TANGENT"]
+    transform = {"KHR_texture_transform": {"offset": [0.5, 0], "rotation": 0.5, "scale": [2, 2]}}
+    d["materials"] = [{"normalTexture": {"index": 0, "scale": 0.5, "extensions": transform},
+                       "occlusionTexture": {"index": 0, "strength": 0.5, "extensions": transform},
+                       "pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0, "extensions": transform}}}]
+    d["extensionsUsed"] = ["KHR_texture_transform"]
+    files["material-maps-generated-tangents.gltf"] = text(d)
+    # Tangents through a morph target and a skin: TANGENT (1, 0, 0, 1), a
+    # target's TANGENT delta (-1, 1, 0) at weight 1 makes it (0, 1, 0), and
+    # the one joint, turned 90 degrees about z, makes that (-1, 0, 0).
+    b = Builder()
+    pos = b.positions(QUAD)
+    nrm = b.vec3([(0, 0, 1)] * 4)
+    idx = b.indices([0, 1, 2, 0, 2, 3])
+    tan = b.accessor([1, 0, 0, 1] * 4, FLOAT, "VEC4")
+    uv = b.vec2([(0, 1), (1, 1), (1, 0), (0, 0)])
+    jnt = b.accessor([0, 0, 0, 0] * 4, USHORT, "VEC4")
+    wgt = b.accessor([1, 0, 0, 0] * 4, FLOAT, "VEC4")
+    delta = b.vec3([(-1, 1, 0)] * 4)
+    attributes = {"POSITION": pos, "NORMAL": nrm, "TANGENT": tan, "TEXCOORD_0": uv,
+                  "JOINTS_0": jnt, "WEIGHTS_0": wgt}
+    mesh = {"primitives": [{"attributes": attributes, "indices": idx, "material": 0,
+                            "targets": [{"TANGENT": delta}]}], "weights": [1]}
+    s45 = 0.7071067811865476
+    files["normal-mapped-skinned-morphed.gltf"] = text(b.gltf(
+        [mesh], [{"mesh": 0, "skin": 0}, {"rotation": [0, 0, s45, s45]}], scenes=[{"nodes": [0, 1]}], scene=0,
+        skins=[{"joints": [1]}], materials=[{"normalTexture": {"index": 0}}], textures=[{"source": 0}],
+        images=[{"uri": "data:image/png;base64," + base64.b64encode(png_1x1()).decode()}]))
     return files
 
 

@@ -39,10 +39,11 @@ Keys:
   instanceList       per instance, in instance order: node, mesh, primitive,
                      mode, triangles
   ignored            what the file uses and rastray does not render (README,
-                     "The scene model"), as {feature: count}: "normal
-                     texture", "occlusion texture", "metallicRoughness
-                     texture" (materials), and each extension not in
-                     SUPPORTED by the objects that hold it; {} when none.
+                     "The scene model"), as {feature: count}: each
+                     extension not in SUPPORTED by the objects that hold
+                     it; {} when none. Normal, occlusion and
+                     metallic-roughness textures are rendered
+                     (docs/MATERIALS.md), not ignored.
                      Animations, skins and morph targets are played
                      (docs/ANIMATION.md), not ignored.
 
@@ -69,11 +70,6 @@ def ignored(doc):
     def note(feature, n=1):
         if n:
             out[feature] = out.get(feature, 0) + n
-
-    for m in doc.get("materials", []):
-        note("normal texture", "normalTexture" in m)
-        note("occlusion texture", "occlusionTexture" in m)
-        note("metallicRoughness texture", "metallicRoughnessTexture" in m.get("pbrMetallicRoughness", {}))
 
     def extensions(value):
         if isinstance(value, list):
