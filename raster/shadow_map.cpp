@@ -101,25 +101,28 @@ ShadowMaps::Lookup lookupOf(const Camera& camera, const ClipSpace& space) {
 }
 
 // Concatenates the tiles' sorted fragments in tile order and indexes
-// them by tile row (Map::attenuationRows).
+// them by tile row (Map::attenuationRows); the tiles in parallel, each
+// from its offset in the concatenation.
 void indexAttenuation(const std::vector<std::vector<ShadowMaps::Attenuation>>& perTile,
                       ShadowMaps::Map* map) {
-  size_t total = 0;
-  for (const auto& v : perTile) total += v.size();
-  map->attenuation.reserve(total);
+  std::vector<size_t> offset(perTile.size() + 1, 0);
+  for (size_t tile = 0; tile < perTile.size(); ++tile) offset[tile + 1] = offset[tile] + perTile[tile].size();
+  map->attenuation.resize(offset.back());
   map->attenuationRows.assign(perTile.size() * size_t(kTileSize) + 1, 0);
   const size_t width = size_t(map->depth.width);
-  for (size_t tile = 0; tile < perTile.size(); ++tile) {
-    const size_t y0 = size_t(map->tiles.rect(int(tile)).y0);
+  parallelFor(0, int(perTile.size()), [&](int t) {
+    const size_t tile = size_t(t);
+    const size_t y0 = size_t(map->tiles.rect(t).y0);
     uint32_t* rows = &map->attenuationRows[tile * size_t(kTileSize)];
+    size_t at = offset[tile];
     size_t next = 0;  // the next row of the tile whose start is not yet set
     for (const ShadowMaps::Attenuation& a : perTile[tile]) {
       const size_t row = a.texel / width - y0;
-      for (; next <= row; ++next) rows[next] = uint32_t(map->attenuation.size());
-      map->attenuation.push_back(a);
+      for (; next <= row; ++next) rows[next] = uint32_t(at);
+      map->attenuation[at++] = a;
     }
-    for (; next < size_t(kTileSize); ++next) rows[next] = uint32_t(map->attenuation.size());
-  }
+    for (; next < size_t(kTileSize); ++next) rows[next] = uint32_t(at);
+  });
   map->attenuationRows.back() = uint32_t(map->attenuation.size());
 }
 
@@ -338,9 +341,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         }
         depth.store(&map.depth);
         // By (texel, key); stable: equal keys keep the order met.
-        std::stable_sort(found.begin(), found.end(), [](const Attenuation& a, const Attenuation& b) {
-          return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
-        });
+        sortTileFragments(rect, size_t(map.depth.width), &found);
       });
       throwIfStopped(options.cancel);
       indexAttenuation(perTile, &map);
@@ -419,6 +420,39 @@ glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world, const glm::dv
                                            [](const Attenuation& f, uint32_t tx) { return f.texel < tx; });
   for (; it != a + last && it->texel == texel && it->key < key; ++it) t *= it->transmittance;
   return t;
+}
+
+void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMaps::Attenuation>* found) {
+  using A = ShadowMaps::Attenuation;
+  const auto before = [](const A& a, const A& b) {
+    return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
+  };
+  std::vector<A>& v = *found;
+  if (v.size() < 256) {
+    std::stable_sort(v.begin(), v.end(), before);
+    return;
+  }
+  // Texel (x, y) of the rect: slot (y − y0)·kTileSize + (x − x0), in the
+  // order of the map's texel index.
+  const size_t x0 = size_t(rect.x0), y0 = size_t(rect.y0);
+  const auto slot = [&](const A& a) {
+    return (a.texel / width - y0) * size_t(kTileSize) + (a.texel % width - x0);
+  };
+  std::vector<uint32_t> c(size_t(kTileSize) * kTileSize + 1, 0);
+  for (const A& a : v) ++c[slot(a) + 1];
+  for (size_t i = 1; i < c.size(); ++i) c[i] += c[i - 1];
+  std::vector<A> sorted(v.size());
+  for (const A& a : v) sorted[c[slot(a)]++] = a;  // stable; c[s] ends at the next slot's start
+  v.swap(sorted);
+  // Each texel's run by key, stably (insertion sort: runs of a few).
+  size_t start = 0;
+  while (start < v.size()) {
+    size_t end = start + 1;
+    while (end < v.size() && v[end].texel == v[start].texel) ++end;
+    for (size_t i = start + 1; i < end; ++i)
+      for (size_t j = i; j > start && v[j].key < v[j - 1].key; --j) std::swap(v[j], v[j - 1]);
+    start = end;
+  }
 }
 
 const ShadowMaps::Map& ShadowMaps::mapAt(size_t i) const { return *maps_.at(i); }
