@@ -105,9 +105,13 @@ ShadowMaps::Lookup lookupOf(const Camera& camera, const ClipSpace& space) {
 // from its offset in the concatenation.
 void indexAttenuation(const std::vector<std::vector<ShadowMaps::Attenuation>>& perTile,
                       ShadowMaps::Map* map) {
+  // The copy first, serially at memory speed (resize() would zero the
+  // storage first, and a per-fragment push_back with the row bookkeeping
+  // cost more than the copy), then the rows' starts in parallel.
   std::vector<size_t> offset(perTile.size() + 1, 0);
   for (size_t tile = 0; tile < perTile.size(); ++tile) offset[tile + 1] = offset[tile] + perTile[tile].size();
-  map->attenuation.resize(offset.back());
+  map->attenuation.reserve(offset.back());
+  for (const auto& v : perTile) map->attenuation.insert(map->attenuation.end(), v.begin(), v.end());
   map->attenuationRows.assign(perTile.size() * size_t(kTileSize) + 1, 0);
   const size_t width = size_t(map->depth.width);
   parallelFor(0, int(perTile.size()), [&](int t) {
@@ -119,7 +123,7 @@ void indexAttenuation(const std::vector<std::vector<ShadowMaps::Attenuation>>& p
     for (const ShadowMaps::Attenuation& a : perTile[tile]) {
       const size_t row = a.texel / width - y0;
       for (; next <= row; ++next) rows[next] = uint32_t(at);
-      map->attenuation[at++] = a;
+      ++at;
     }
     for (; next < size_t(kTileSize); ++next) rows[next] = uint32_t(at);
   });
@@ -433,26 +437,35 @@ void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMap
     return;
   }
   // Texel (x, y) of the rect: slot (y − y0)·kTileSize + (x − x0), in the
-  // order of the map's texel index.
-  const size_t x0 = size_t(rect.x0), y0 = size_t(rect.y0);
-  const auto slot = [&](const A& a) {
-    return (a.texel / width - y0) * size_t(kTileSize) + (a.texel % width - x0);
-  };
-  std::vector<uint32_t> c(size_t(kTileSize) * kTileSize + 1, 0);
-  for (const A& a : v) ++c[slot(a) + 1];
-  for (size_t i = 1; i < c.size(); ++i) c[i] += c[i - 1];
-  std::vector<A> sorted(v.size());
-  for (const A& a : v) sorted[c[slot(a)]++] = a;  // stable; c[s] ends at the next slot's start
-  v.swap(sorted);
-  // Each texel's run by key, stably (insertion sort: runs of a few).
-  size_t start = 0;
-  while (start < v.size()) {
-    size_t end = start + 1;
-    while (end < v.size() && v[end].texel == v[start].texel) ++end;
-    for (size_t i = start + 1; i < end; ++i)
-      for (size_t j = i; j > start && v[j].key < v[j - 1].key; --j) std::swap(v[j], v[j - 1]);
-    start = end;
+  // order of the map's texel index; computed once per fragment (texel
+  // indices fit 32 bits: a 32-bit division). The buffers are the thread's
+  // own, kept between tiles.
+  const uint32_t w = uint32_t(width), x0 = uint32_t(rect.x0), y0 = uint32_t(rect.y0);
+  thread_local std::vector<uint16_t> slots;
+  thread_local std::vector<uint32_t> start;
+  thread_local std::vector<A> sorted;
+  slots.resize(v.size());
+  start.assign(size_t(kTileSize) * kTileSize + 1, 0);
+  for (size_t i = 0; i < v.size(); ++i) {
+    const uint32_t y = v[i].texel / w, x = v[i].texel - y * w;
+    slots[i] = uint16_t((y - y0) * uint32_t(kTileSize) + (x - x0));
+    ++start[size_t(slots[i]) + 1];
   }
+  for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  sorted.resize(v.size());
+  {
+    thread_local std::vector<uint32_t> next;
+    next.assign(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < v.size(); ++i) sorted[next[slots[i]]++] = v[i];  // stable
+  }
+  // Each texel's run by key, stably (insertion sort: runs of a few).
+  for (size_t t = 0; t + 1 < start.size(); ++t) {
+    const size_t first = start[t], last = start[t + 1];
+    for (size_t i = first + 1; i < last; ++i)
+      for (size_t j = i; j > first && sorted[j].key < sorted[j - 1].key; --j)
+        std::swap(sorted[j], sorted[j - 1]);
+  }
+  std::copy(sorted.begin(), sorted.end(), v.begin());
 }
 
 const ShadowMaps::Map& ShadowMaps::mapAt(size_t i) const { return *maps_.at(i); }
