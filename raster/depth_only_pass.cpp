@@ -385,6 +385,25 @@ bool hasAvx2() {
   static const bool yes = __builtin_cpu_supports("avx2");
   return yes;
 }
+
+// The tile buffer's clear and its rows' streaming out, 32 bytes a store
+// (a 2048² cube map clears and writes 100 MB a frame; 16-byte stores were
+// about a tenth of the map pass).
+__attribute__((target("avx2"))) void clearAvx2(int32_t* keys, size_t n) {
+  const __m256i clear = _mm256_set1_epi32(kClearBiased);
+  for (size_t i = 0; i < n; i += 8) _mm256_store_si256(reinterpret_cast<__m256i*>(keys + i), clear);
+}
+
+// Streams src[i] ^ kBias into dst for the leading multiple of 8 of
+// `width` (dst 32-byte aligned); returns how many were written.
+__attribute__((target("avx2"))) int streamRowAvx2(uint32_t* dst, const int32_t* src, int width) {
+  const __m256i bias = _mm256_set1_epi32(int32_t(kBias));
+  int i = 0;
+  for (; i + 8 <= width; i += 8)
+    _mm256_stream_si256(reinterpret_cast<__m256i*>(dst + i),
+                        _mm256_xor_si256(_mm256_load_si256(reinterpret_cast<const __m256i*>(src + i)), bias));
+  return i;
+}
 #endif
 
 }  // namespace
@@ -462,7 +481,15 @@ void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::
   const int height = rect.y1 - rect.y0;
   // Clear the rows in use, whole (GCC 12 does not vectorise loops at -O2:
   // a scalar fill here cost as much as a sixth of the drawing).
-#if defined(__SSE2__)
+#if defined(RASTRAY_DEPTH_ONLY_AVX2)
+  if (hasAvx2()) {
+    clearAvx2(keys_, size_t(height) * kTileSize);  // rows of kTileSize: a multiple of 8
+  } else {
+    const __m128i clear = _mm_set1_epi32(kClearBiased);
+    for (size_t i = 0; i < size_t(height) * kTileSize; i += 4)
+      _mm_store_si128(reinterpret_cast<__m128i*>(&keys_[i]), clear);
+  }
+#elif defined(__SSE2__)
   const __m128i clear = _mm_set1_epi32(kClearBiased);
   for (size_t i = 0; i < size_t(height) * kTileSize; i += 4)
     _mm_store_si128(reinterpret_cast<__m128i*>(&keys_[i]), clear);
@@ -514,6 +541,9 @@ void DepthOnlyTile::store(DepthMap* map) const {
     // are whenever the width is a multiple of 4 (tiles start at multiples
     // of 64 texels).
     const __m128i bias = _mm_set1_epi32(int32_t(kBias));
+#if defined(RASTRAY_DEPTH_ONLY_AVX2)
+    if ((reinterpret_cast<uintptr_t>(dst) & 31) == 0 && hasAvx2()) i = streamRowAvx2(dst, src, width);
+#endif
     if ((reinterpret_cast<uintptr_t>(dst) & 15) == 0)
       for (; i + 4 <= width; i += 4)
         _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i),
