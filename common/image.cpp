@@ -110,6 +110,15 @@ void writePng(const std::string& path, const FlatImage& image) {
   oiioModule().writeRgba8Png(path, temporaryPathFor(path), image.width, image.height, rgba.data());
 }
 
+std::string encodePngQuick(const FlatImage& image) {
+  checkFlat(image);
+  std::vector<uint8_t> rgba(image.color.size() * 4);
+  encodeRgba8(image.color.data(), image.color.size(), rgba.data());
+  const std::vector<unsigned char> png =
+      oiioModule().encodeRgba8PngQuick(image.width, image.height, rgba.data());
+  return std::string(png.begin(), png.end());
+}
+
 void writeExr(const std::string& path, const FlatImage& image, ColorPrecision precision) {
   checkFlat(image);
   oiioModule().writeExr(path, temporaryPathFor(path), image, precision);

@@ -98,6 +98,11 @@ enum class ColorPrecision { Half, Float };
 void writeImage(const std::string& path, const FlatImage& image,
                 ColorPrecision precision = ColorPrecision::Half);
 void writePng(const std::string& path, const FlatImage& image);
+// The PNG writePng writes (the same pixels), in memory and compressed for
+// speed rather than size (no row filter, zlib level 1): about 5 ms instead
+// of 35-40 ms at 640x480, a file about twice as large. The explorer's
+// previews.
+std::string encodePngQuick(const FlatImage& image);
 void writeExr(const std::string& path, const FlatImage& image,
               ColorPrecision precision = ColorPrecision::Half);
 void writeDeepExr(const std::string& path, const DeepImage& image);

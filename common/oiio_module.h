@@ -58,6 +58,9 @@ struct OiioFunctions {
   // luminance (cd/m²) and field of view (degrees). Throws std::runtime_error.
   ImageDifference (*compareColors)(int width, int height, const glm::vec4* a, const glm::vec4* b,
                                    float yeeLuminance, float yeeFieldOfView);
+  // writeRgba8Png's pixels and attributes as a PNG in memory, compressed
+  // for speed (no row filter, zlib level 1): the explorer's previews.
+  std::vector<unsigned char> (*encodeRgba8PngQuick)(int width, int height, const uint8_t* rgba);
 };
 
 // What the program lends the module: the functions of common/ it calls,
@@ -70,7 +73,7 @@ struct OiioHost {
   std::string (*formatBytes)(uint64_t bytes);
 };
 
-constexpr int kOiioModuleVersion = 2;
+constexpr int kOiioModuleVersion = 3;
 
 // Loads the module on the first call (thread-safe) and returns its
 // functions. Looks beside the running program, one folder up (test,

@@ -101,25 +101,32 @@ ShadowMaps::Lookup lookupOf(const Camera& camera, const ClipSpace& space) {
 }
 
 // Concatenates the tiles' sorted fragments in tile order and indexes
-// them by tile row (Map::attenuationRows).
+// them by tile row (Map::attenuationRows); the tiles in parallel, each
+// from its offset in the concatenation.
 void indexAttenuation(const std::vector<std::vector<ShadowMaps::Attenuation>>& perTile,
                       ShadowMaps::Map* map) {
-  size_t total = 0;
-  for (const auto& v : perTile) total += v.size();
-  map->attenuation.reserve(total);
+  // The copy first, serially at memory speed (resize() would zero the
+  // storage first, and a per-fragment push_back with the row bookkeeping
+  // cost more than the copy), then the rows' starts in parallel.
+  std::vector<size_t> offset(perTile.size() + 1, 0);
+  for (size_t tile = 0; tile < perTile.size(); ++tile) offset[tile + 1] = offset[tile] + perTile[tile].size();
+  map->attenuation.reserve(offset.back());
+  for (const auto& v : perTile) map->attenuation.insert(map->attenuation.end(), v.begin(), v.end());
   map->attenuationRows.assign(perTile.size() * size_t(kTileSize) + 1, 0);
   const size_t width = size_t(map->depth.width);
-  for (size_t tile = 0; tile < perTile.size(); ++tile) {
-    const size_t y0 = size_t(map->tiles.rect(int(tile)).y0);
+  parallelFor(0, int(perTile.size()), [&](int t) {
+    const size_t tile = size_t(t);
+    const size_t y0 = size_t(map->tiles.rect(t).y0);
     uint32_t* rows = &map->attenuationRows[tile * size_t(kTileSize)];
+    size_t at = offset[tile];
     size_t next = 0;  // the next row of the tile whose start is not yet set
     for (const ShadowMaps::Attenuation& a : perTile[tile]) {
       const size_t row = a.texel / width - y0;
-      for (; next <= row; ++next) rows[next] = uint32_t(map->attenuation.size());
-      map->attenuation.push_back(a);
+      for (; next <= row; ++next) rows[next] = uint32_t(at);
+      ++at;
     }
-    for (; next < size_t(kTileSize); ++next) rows[next] = uint32_t(map->attenuation.size());
-  }
+    for (; next < size_t(kTileSize); ++next) rows[next] = uint32_t(at);
+  });
   map->attenuationRows.back() = uint32_t(map->attenuation.size());
 }
 
@@ -338,9 +345,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         }
         depth.store(&map.depth);
         // By (texel, key); stable: equal keys keep the order met.
-        std::stable_sort(found.begin(), found.end(), [](const Attenuation& a, const Attenuation& b) {
-          return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
-        });
+        sortTileFragments(rect, size_t(map.depth.width), &found);
       });
       throwIfStopped(options.cancel);
       indexAttenuation(perTile, &map);
@@ -419,6 +424,48 @@ glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world, const glm::dv
                                            [](const Attenuation& f, uint32_t tx) { return f.texel < tx; });
   for (; it != a + last && it->texel == texel && it->key < key; ++it) t *= it->transmittance;
   return t;
+}
+
+void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMaps::Attenuation>* found) {
+  using A = ShadowMaps::Attenuation;
+  const auto before = [](const A& a, const A& b) {
+    return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
+  };
+  std::vector<A>& v = *found;
+  if (v.size() < 256) {
+    std::stable_sort(v.begin(), v.end(), before);
+    return;
+  }
+  // Texel (x, y) of the rect: slot (y − y0)·kTileSize + (x − x0), in the
+  // order of the map's texel index; computed once per fragment (texel
+  // indices fit 32 bits: a 32-bit division). The buffers are the thread's
+  // own, kept between tiles.
+  const uint32_t w = uint32_t(width), x0 = uint32_t(rect.x0), y0 = uint32_t(rect.y0);
+  thread_local std::vector<uint16_t> slots;
+  thread_local std::vector<uint32_t> start;
+  thread_local std::vector<A> sorted;
+  slots.resize(v.size());
+  start.assign(size_t(kTileSize) * kTileSize + 1, 0);
+  for (size_t i = 0; i < v.size(); ++i) {
+    const uint32_t y = v[i].texel / w, x = v[i].texel - y * w;
+    slots[i] = uint16_t((y - y0) * uint32_t(kTileSize) + (x - x0));
+    ++start[size_t(slots[i]) + 1];
+  }
+  for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  sorted.resize(v.size());
+  {
+    thread_local std::vector<uint32_t> next;
+    next.assign(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < v.size(); ++i) sorted[next[slots[i]]++] = v[i];  // stable
+  }
+  // Each texel's run by key, stably (insertion sort: runs of a few).
+  for (size_t t = 0; t + 1 < start.size(); ++t) {
+    const size_t first = start[t], last = start[t + 1];
+    for (size_t i = first + 1; i < last; ++i)
+      for (size_t j = i; j > first && sorted[j].key < sorted[j - 1].key; --j)
+        std::swap(sorted[j], sorted[j - 1]);
+  }
+  std::copy(sorted.begin(), sorted.end(), v.begin());
 }
 
 const ShadowMaps::Map& ShadowMaps::mapAt(size_t i) const { return *maps_.at(i); }

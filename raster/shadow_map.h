@@ -150,4 +150,12 @@ class ShadowMaps : public LightVisibility {
   uint64_t attenuating_ = 0;
 };
 
+// Sorts one map tile's transmissive fragments (texels of `rect`, in a map
+// `width` texels wide) by (texel, key), equal pairs in the order given:
+// std::stable_sort's result. Many fragments (a glass sphere over the tile:
+// thousands, a few per texel) are counted into texel order in one linear
+// pass and each texel's few then sorted by key; fewer go to
+// std::stable_sort.
+void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMaps::Attenuation>* fragments);
+
 }  // namespace rastray

@@ -81,6 +81,9 @@ bool takeServerParameter(RequestParameters& r, Endpoint endpoint, const std::str
     r.pair = value;
   } else if ((name == "x" || name == "y") && endpoint == Endpoint::Explain) {
     (name == "x" ? r.x : r.y) = parsePixel(name, value);
+  } else if (name == "png" && endpoint == Endpoint::Frame) {
+    if (value != "quick" && value != "small") badRequest("png: '" + value + "' is not one of quick, small");
+    r.quickPng = value == "quick";
   } else if (name == "client") {
     if (value.size() > 64) badRequest("client: longer than 64 characters");
     r.client = value;
@@ -105,6 +108,7 @@ void checkCombination(const RequestParameters& r, Endpoint endpoint, const std::
         (endpoint == Endpoint::Explain ? "explain" : "the " + std::string(toString(r.view)) + " view") +
         " runs every renderer, as crossval does");
   if (pairGiven && r.view == View::Image) badRequest("pair: only the maps compare a pair of renderers");
+  if (r.quickPng && r.view != View::Image) badRequest("png: only the image view's PNG can be quick");
 }
 
 }  // namespace

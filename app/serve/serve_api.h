@@ -56,6 +56,9 @@ struct RequestParameters {
   // table's order, "--renderer R" first for the image view.
   std::vector<std::string> renderArgs;
   int x = -1, y = -1;  // the pixel explained (Endpoint::Explain)
+  // png=quick (image view): the PNG compressed for speed, not size
+  // (encodePngQuick: the same pixels); the explorer's previews ask for it.
+  bool quickPng = false;
   // Supersession: a later seq of the same client makes this one obsolete.
   std::string client;
   uint64_t seq = 0;

@@ -156,9 +156,10 @@ std::shared_ptr<PreparedFrame> SceneCache::frame(const std::string& path,
   frame->raster = settings.raster;
   frame->ray = settings.ray;
   frame->raster.keepSamples = frame->ray.keepSamples = false;
-  // Previews of one frame reuse their buffers (a request that finds them
-  // busy, a concurrent one, allocates its own).
-  frame->raster.frameBuffers = &frame->buffers;
+  // Previews reuse the cache's buffers, whatever their frame (a request
+  // that finds them busy, a concurrent one, allocates its own).
+  frame->buffers = &buffers_;
+  frame->raster.frameBuffers = frame->buffers;
   // A request's token is set for its render alone (renderPrepared's caller).
   frame->settings.raster.cancel = frame->raster.cancel = nullptr;
   frame->settings.ray.cancel = frame->ray.cancel = nullptr;

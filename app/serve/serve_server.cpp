@@ -216,10 +216,11 @@ json ExplorerServer::Impl::imageFrame(const RequestParameters& r, const std::str
     ~TokenScope() { frame.raster.cancel = frame.ray.cancel = nullptr; }
   } scope(*prepared, s.raster.cancel);
   RenderRun run = renderPrepared(*prepared);
-  png = scratch.png([&](const std::string& file) { writePng(file, run.output.image); });
+  png = r.quickPng ? encodePngQuick(run.output.image)
+                   : scratch.png([&](const std::string& file) { writePng(file, run.output.image); });
   json work = ordered(renderReportJson(*prepared->scene, s, run));
   // The encoded image's storage serves this frame's next preview.
-  prepared->buffers.recycle(std::move(run.output.image));
+  prepared->buffers->recycle(std::move(run.output.image));
   // Where the BVH came from: none (the rasterizer alone), built by this
   // request, or kept from an earlier one (the same frame, or another frame
   // over the same rebased scene and culling mode).

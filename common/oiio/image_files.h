@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "common/image.h"
 
@@ -11,6 +12,9 @@ namespace rastray::oiio {
 
 void writeRgba8Png(const std::string& path, const std::string& tmp, int width, int height,
                    const uint8_t* rgba);
+// writeRgba8Png's image (the same pixels and attributes) in memory, quickly
+// compressed: no row filter, zlib level 1.
+std::vector<unsigned char> encodeRgba8PngQuick(int width, int height, const uint8_t* rgba);
 void writeExr(const std::string& path, const std::string& tmp, const FlatImage& image,
               ColorPrecision precision);
 void writeDeepExr(const std::string& path, const std::string& tmp, const DeepImage& image);

@@ -90,9 +90,9 @@ ImageDifference compareColors(int width, int height, const glm::vec4* a, const g
   return d;
 }
 
-const OiioFunctions kFunctions = {kOiioModuleVersion, writeRgba8Png,  writeExr,     writeDeepExr,
-                                  isDeepExr,          exrChannelType, readExr,      readDeepExr,
-                                  resizeBox,          encodePng,      compareColors};
+const OiioFunctions kFunctions = {kOiioModuleVersion, writeRgba8Png,  writeExr,      writeDeepExr,
+                                  isDeepExr,          exrChannelType, readExr,       readDeepExr,
+                                  resizeBox,          encodePng,      compareColors, encodeRgba8PngQuick};
 
 }  // namespace
 }  // namespace oiio

@@ -11,9 +11,11 @@
 
 #include <gtest/gtest.h>
 #include <httplib.h>
+#include <stb/stb_image.h>
 #include <nlohmann/json.hpp>
 
 #include "app/serve/serve_api.h"
+#include "app/serve/serve_scenes.h"
 #include "app/serve/serve_server.h"
 #include "run_command.h"
 #include "tests/test_files.h"
@@ -181,6 +183,68 @@ TEST_F(ServeTest, RasterPreviewsReuseTheirBuffersAndKeepThePicture) {
     EXPECT_EQ(a["image"], b["image"]) << spp;
     EXPECT_EQ(a["image"], c["image"]) << spp;
   }
+}
+
+// Decoded RGBA bytes of a PNG (stb_image), empty when it does not decode.
+std::vector<unsigned char> pngPixels(const std::string& png) {
+  int w = 0, h = 0, n = 0;
+  unsigned char* p = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(png.data()),
+                                           int(png.size()), &w, &h, &n, 4);
+  if (!p) return {};
+  std::vector<unsigned char> out(p, p + size_t(w) * size_t(h) * 4);
+  stbi_image_free(p);
+  return out;
+}
+
+// The previews' png=quick: the same pixels as the command line's PNG,
+// other bytes (no row filter, zlib level 1), and in the JSON frame too;
+// frames of other cameras share one buffer pool, so previews after an
+// orbit step render into the last camera's stale storage and keep their
+// picture. png takes quick or small, and only in the image view.
+TEST_F(ServeTest, QuickPreviewPngsHoldTheCommandLinesPixels) {
+  const std::vector<std::string> cameras = {"&eye=0.3,0.9,3.4&target=0,0.9,0&up=0,1,0",
+                                            "&eye=-0.4,1.1,3.3&target=0,0.9,0&up=0,1,0", ""};
+  for (const char* spp : {"1", "4"})
+    for (const std::string& camera : cameras) {
+      const std::string settings = cornell() + "&size=131,67&renderer=raster&spp=" + spp + camera;
+      const auto small = get("/api/image?" + settings);
+      const auto quick = get("/api/image?" + settings + "&png=quick");
+      const auto frame = get("/api/frame?" + settings + "&png=quick");
+      ASSERT_TRUE(small && quick && frame);
+      ASSERT_EQ(quick->status, 200) << quick->body;
+      EXPECT_EQ(quick->get_header_value("Content-Type"), "image/png");
+      EXPECT_NE(quick->body, small->body) << "png=quick encodes otherwise";
+      const std::vector<unsigned char> pixels = pngPixels(small->body);
+      ASSERT_EQ(pixels.size(), size_t(131 * 67 * 4));
+      EXPECT_TRUE(pngPixels(quick->body) == pixels) << spp << camera;
+      EXPECT_EQ(json::parse(frame->body)["image"], "data:image/png;base64," + serve::base64(quick->body));
+    }
+  const auto bad = get("/api/image?" + cornell() + "&size=40,30&png=fast");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("png: 'fast' is not one of quick, small"), std::string::npos) << bad->body;
+  const auto map = get("/api/frame?" + cornell() + "&size=40,30&view=mismatch&png=quick");
+  ASSERT_TRUE(map);
+  EXPECT_EQ(map->status, 400) << map->body;
+}
+
+// Every prepared frame renders into the cache's one buffer pool: an orbit
+// prepares a frame per camera, and a pool per frame allocated a fresh
+// image (and the kernel zeroed its pages) for every preview.
+TEST(ServeSceneCache, FramesOfEveryCameraShareOneBufferPool) {
+  serve::SceneCache cache;
+  const std::string path = scenePath("cornell-box");
+  std::vector<std::shared_ptr<serve::PreparedFrame>> frames;
+  for (const char* eye : {"0.3,0.9,3.4", "-0.4,1.1,3.3"}) {
+    serve::QueryParameters q = {{"scene", path}, {"size", "40x30"}, {"eye", eye}};
+    const serve::RequestParameters r = serve::parseRequest(q, serve::Endpoint::Frame);
+    frames.push_back(cache.frame(path, r.renderArgs, serve::renderSettings(r)));
+  }
+  ASSERT_NE(frames[0], frames[1]);
+  ASSERT_NE(frames[0]->buffers, nullptr);
+  EXPECT_EQ(frames[0]->buffers, frames[1]->buffers);
+  EXPECT_EQ(frames[0]->raster.frameBuffers, frames[0]->buffers);
+  EXPECT_EQ(frames[1]->raster.frameBuffers, frames[1]->buffers);
 }
 
 // The BVH depends on the rebased scene and the culling mode only: changing

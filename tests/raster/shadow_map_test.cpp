@@ -90,6 +90,42 @@ TEST(ShadowMapPass, FastMapsEqualTheReferenceWalks) {
   }
 }
 
+// The tiles' fragment sort gives std::stable_sort's order by (texel,
+// key): few fragments and many (the counting pass), every texel of a
+// corner tile and of an edge tile narrower than kTileSize, equal keys at
+// a texel (coplanar layers) kept in the order met.
+TEST(ShadowMapPass, TileFragmentSortIsTheStableSortByTexelAndKey) {
+  std::mt19937 rng(17);
+  const size_t width = 150;  // tiles of 64, 64 and 22 texels across
+  const TileGrid tiles(int(width), 100);
+  for (int tile : {0, 2, tiles.count() - 1})
+    for (size_t n :
+         {size_t(0), size_t(1), size_t(40), size_t(255), size_t(256), size_t(3000), size_t(20000)}) {
+      const TileRect rect = tiles.rect(tile);
+      const int w = rect.x1 - rect.x0, h = rect.y1 - rect.y0;
+      std::vector<ShadowMaps::Attenuation> v;
+      for (size_t i = 0; i < n; ++i) {
+        // A few texels hold many fragments; keys from a small set, so ties abound.
+        const int x = rect.x0 + int(rng() % uint32_t(i % 3 == 0 ? 2 : w));
+        const int y = rect.y0 + int(rng() % uint32_t(i % 3 == 0 ? 2 : h));
+        v.push_back({uint32_t(size_t(y) * width + size_t(x)), uint32_t(rng() % 5), glm::vec3(float(i))});
+      }
+      std::vector<ShadowMaps::Attenuation> expected = v;
+      std::stable_sort(expected.begin(), expected.end(),
+                       [](const ShadowMaps::Attenuation& a, const ShadowMaps::Attenuation& b) {
+                         return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
+                       });
+      sortTileFragments(rect, width, &v);
+      ASSERT_EQ(v.size(), expected.size());
+      for (size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(v[i].texel, expected[i].texel) << "tile " << tile << " n " << n << " at " << i;
+        ASSERT_EQ(v[i].key, expected[i].key) << "tile " << tile << " n " << n << " at " << i;
+        ASSERT_EQ(v[i].transmittance, expected[i].transmittance)
+            << "tile " << tile << " n " << n << " at " << i;
+      }
+    }
+}
+
 TEST(ShadowMapLookup, FastLookupReturnsTheReferenceBits) {
   Fixture f(200);  // not a multiple of the tile size: partial tiles in the row index
   const ShadowMaps maps(f.scene, f.options, &f.shader);
