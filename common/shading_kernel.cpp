@@ -450,6 +450,7 @@ class BlockShader {
   }
 
   bool full() const { return block_.used == kBlock; }
+  size_t used() const { return block_.used; }
 
   // Gathers hit `h` (to be written to `*out`) into the next lane.
   void add(const ShadeHit& h, const Material& m, glm::vec4* out) {
@@ -458,24 +459,7 @@ class BlockShader {
     outputs_[i] = out;
     // Consecutive hits mostly share a triangle: its data is looked up once
     // per run (the same values, so the lane does not depend on the run).
-    const bool newTriangle = h.instance != run_.instance || h.triangle != run_.triangle;
-    if (newTriangle) startRun(h.instance, h.triangle);
-    if (newTriangle || b.runs == 0) {
-      // The run's entry in the block's table.
-      const size_t r = b.runs++;
-      b.ngX[r] = run_.ngF.x;
-      b.ngY[r] = run_.ngF.y;
-      b.ngZ[r] = run_.ngF.z;
-      b.authored[r] = run_.authored ? 1.0f : 0.0f;
-      b.n0X[r] = run_.n0.x, b.n0Y[r] = run_.n0.y, b.n0Z[r] = run_.n0.z;
-      b.n1X[r] = run_.n1.x, b.n1Y[r] = run_.n1.y, b.n1Z[r] = run_.n1.z;
-      b.n2X[r] = run_.n2.x, b.n2Y[r] = run_.n2.y, b.n2Z[r] = run_.n2.z;
-      b.diffuseWeight[r] = (1.0f - m.mirrorWeight()) * (1.0f - m.transmission);
-      b.ngXd[r] = run_.ng.x, b.ngYd[r] = run_.ng.y, b.ngZd[r] = run_.ng.z;
-      b.p0X[r] = run_.p0.x, b.p0Y[r] = run_.p0.y, b.p0Z[r] = run_.p0.z;
-      b.p1X[r] = run_.p1.x, b.p1Y[r] = run_.p1.y, b.p1Z[r] = run_.p1.z;
-      b.p2X[r] = run_.p2.x, b.p2Y[r] = run_.p2.y, b.p2Z[r] = run_.p2.z;
-    }
+    enterRun(h.instance, h.triangle, m);
     b.run[i] = int32_t(b.runs - 1);
     b.run64[i] = int64_t(b.runs - 1);
     const Instance& inst = *run_.inst;
@@ -518,6 +502,54 @@ class BlockShader {
     b.emitG[i] = emit.g;
     b.emitB[i] = emit.b;
     b.alpha[i] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
+  }
+
+  // Gathers hits [first, end) of `h`, one run (one triangle, material
+  // `m`), the colour of hit k to colors[h.colorIndex[k]]; the block has
+  // room for them. The lanes get the values add() would give them; where
+  // neither a texture, vertex colours nor a visibility callback needs the
+  // hit's own surface, the base colour and emission are the run's.
+  void addRun(const PrimaryHitBlock& h, size_t first, size_t end, const Material& m, glm::vec4* colors) {
+    const uint32_t instance = h.runInstance[h.run[first]], triangle = h.runTriangle[h.run[first]];
+    if (&m != material_) {
+      material_ = &m;
+      textured_ = samplesTexture(shader_, m);
+    }
+    if (textured_ || visible_ || scene_.instances[instance].hasColors) {
+      for (size_t k = first; k < end; ++k) {
+        ShadeHit s;
+        s.instance = instance;
+        s.triangle = triangle;
+        s.b1 = h.b1[k];
+        s.b2 = h.b2[k];
+        s.direction = glm::dvec3(h.dirX[k], h.dirY[k], h.dirZ[k]);
+        s.footprintPosition = glm::dvec2(h.footprintX[k], h.footprintY[k]);
+        add(s, m, &colors[h.colorIndex[k]]);
+      }
+      return;
+    }
+    LaneBlock& b = block_;
+    enterRun(instance, triangle, m);
+    const size_t i0 = b.used, n = end - first;
+    b.used += n;
+    const int32_t r = int32_t(b.runs - 1);
+    std::fill_n(b.run + i0, n, r);
+    std::fill_n(b.run64 + i0, n, int64_t(r));
+    std::copy_n(h.dirX + first, n, b.dirXd + i0);
+    std::copy_n(h.dirY + first, n, b.dirYd + i0);
+    std::copy_n(h.dirZ + first, n, b.dirZd + i0);
+    std::copy_n(h.b1 + first, n, b.b1 + i0);
+    std::copy_n(h.b2 + first, n, b.b2 + i0);
+    const glm::vec4 base = m.baseColorFactor;
+    const glm::vec3 emit = m.emissive;
+    std::fill_n(b.albedoR + i0, n, base.r);
+    std::fill_n(b.albedoG + i0, n, base.g);
+    std::fill_n(b.albedoB + i0, n, base.b);
+    std::fill_n(b.emitR + i0, n, emit.r);
+    std::fill_n(b.emitG + i0, n, emit.g);
+    std::fill_n(b.emitB + i0, n, emit.b);
+    std::fill_n(b.alpha + i0, n, m.alphaMode == AlphaMode::Blend ? base.a : 1.0f);
+    for (size_t k = 0; k < n; ++k) outputs_[i0 + k] = &colors[h.colorIndex[first + k]];
   }
 
   // Shades the gathered lanes and writes their colours; empties the block.
@@ -580,6 +612,30 @@ class BlockShader {
     bool authored = false;
     glm::vec3 n0{0.0f}, n1{0.0f}, n2{0.0f};
   };
+
+  // The lanes that follow are on (instance, triangle) with material `m`:
+  // a new entry in the block's run table unless the last one is the same
+  // triangle (the same values either way, so a lane does not depend on
+  // its neighbours).
+  void enterRun(uint32_t instance, uint32_t triangle, const Material& m) {
+    LaneBlock& b = block_;
+    const bool newTriangle = instance != run_.instance || triangle != run_.triangle;
+    if (newTriangle) startRun(instance, triangle);
+    if (!newTriangle && b.runs != 0) return;
+    const size_t r = b.runs++;
+    b.ngX[r] = run_.ngF.x;
+    b.ngY[r] = run_.ngF.y;
+    b.ngZ[r] = run_.ngF.z;
+    b.authored[r] = run_.authored ? 1.0f : 0.0f;
+    b.n0X[r] = run_.n0.x, b.n0Y[r] = run_.n0.y, b.n0Z[r] = run_.n0.z;
+    b.n1X[r] = run_.n1.x, b.n1Y[r] = run_.n1.y, b.n1Z[r] = run_.n1.z;
+    b.n2X[r] = run_.n2.x, b.n2Y[r] = run_.n2.y, b.n2Z[r] = run_.n2.z;
+    b.diffuseWeight[r] = (1.0f - m.mirrorWeight()) * (1.0f - m.transmission);
+    b.ngXd[r] = run_.ng.x, b.ngYd[r] = run_.ng.y, b.ngZd[r] = run_.ng.z;
+    b.p0X[r] = run_.p0.x, b.p0Y[r] = run_.p0.y, b.p0Z[r] = run_.p0.z;
+    b.p1X[r] = run_.p1.x, b.p1Y[r] = run_.p1.y, b.p1Z[r] = run_.p1.z;
+    b.p2X[r] = run_.p2.x, b.p2Y[r] = run_.p2.y, b.p2Z[r] = run_.p2.z;
+  }
 
   void startRun(uint32_t instance, uint32_t triangle) {
     TriangleRun& r = run_;
@@ -663,6 +719,63 @@ void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, 
     if (block->full()) block->run();
   }
   if (block) block->run();
+}
+
+struct PrimaryHitShader::Impl {
+  Impl(const Shader& s, ShadingPath path)
+      : shader(s), reference(path == ShadingPath::Reference || s.options().referenceShading) {}
+  const Shader& shader;
+  const bool reference;
+  std::optional<BlockShader> block;  // built at the first lane, as in shadePrimaryHits
+  uint32_t runInstance = kNoId;      // the path is a function of the material: decided once per instance
+  const Material* material = nullptr;
+  bool scalar = false;
+};
+
+PrimaryHitShader::PrimaryHitShader(const Shader& shader, ShadingPath path)
+    : impl_(std::make_unique<Impl>(shader, path)) {}
+
+PrimaryHitShader::~PrimaryHitShader() = default;
+
+void PrimaryHitShader::shade(const PrimaryHitBlock& h, glm::vec4* colors) {
+  Impl& s = *impl_;
+  const auto shadeHit = [&](size_t k) {
+    ShadeHit one;
+    one.instance = h.runInstance[h.run[k]];
+    one.triangle = h.runTriangle[h.run[k]];
+    one.b1 = h.b1[k];
+    one.b2 = h.b2[k];
+    one.direction = glm::dvec3(h.dirX[k], h.dirY[k], h.dirZ[k]);
+    one.footprintPosition = glm::dvec2(h.footprintX[k], h.footprintY[k]);
+    colors[h.colorIndex[k]] = shadeReference(s.shader, one);
+  };
+  if (s.reference) {
+    for (size_t k = 0; k < h.count; ++k) shadeHit(k);
+    return;
+  }
+  for (size_t first = 0, end = 0; first < h.count; first = end) {
+    const int32_t run = h.run[first];
+    for (end = first + 1; end < h.count && h.run[end] == run; ++end) {
+    }
+    const uint32_t instance = h.runInstance[run];
+    if (instance != s.runInstance) {
+      s.runInstance = instance;
+      s.material = &s.shader.scene().materialOf(instance);
+      s.scalar = needsScalarShade(s.shader, *s.material);
+    }
+    if (s.scalar) {
+      for (size_t k = first; k < end; ++k) shadeHit(k);
+      continue;
+    }
+    if (!s.block) s.block.emplace(s.shader);
+    if (s.block->used() + (end - first) > kBlock) s.block->run();  // more hits than a block: in pieces
+    for (size_t piece = first; piece < end; piece += kBlock) {
+      const size_t pieceEnd = std::min(end, piece + kBlock);
+      if (piece > first) s.block->run();
+      s.block->addRun(h, piece, pieceEnd, *s.material, colors);
+    }
+  }
+  if (s.block) s.block->run();
 }
 
 void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,

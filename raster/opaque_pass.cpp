@@ -48,44 +48,33 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     uint32_t local;   // TileSampleIndex
     uint32_t source;  // the sample whose colour it takes
   };
-  thread_local std::vector<uint32_t> winners;       // setup per request
-  thread_local std::vector<glm::dvec2> positions;   // image position per request
-  thread_local std::vector<uint32_t> requestLocal;  // the sample a request is shaded at
-  thread_local std::vector<SampleHit> hits;         // interpolated, per request
-  thread_local std::vector<glm::dvec2> footprints;  // image position of the texture footprint
-  thread_local std::vector<ShadeHit> requests;      // refined
   thread_local std::vector<Assignment> assignments;
-  // Requests are shaded a chunk at a time as the loop gathers them, so a
-  // chunk's inputs, hits and refined requests stay in the core's caches
-  // (a whole tile's would not: about 0.7 MB at 1 spp). Sized once, filled
-  // through plain pointers (no push_back in the sample loop).
-  constexpr size_t kChunk = 256;
-  for (auto* v : {&winners, &requestLocal}) v->resize(kChunk);
-  for (auto* v : {&positions, &footprints}) v->resize(kChunk);
-  hits.resize(kChunk);
-  requests.resize(kChunk);
-  uint32_t* const winnerOut = winners.data();
-  uint32_t* const localOut = requestLocal.data();
-  glm::dvec2* const positionOut = positions.data();
-  glm::dvec2* const footprintOut = footprints.data();
-  size_t count = 0;
+  // A block of winners at a time: the winner loop adds each to the fused
+  // pass's block (PrimaryBatch: interpolated hit, primary ray, refinement
+  // in double lanes), whose results go to the kernel as struct of arrays.
+  PrimaryBatch batch(primaryConstants_, scene_, setups_.data());
+  PrimaryHitShader kernel(shader_, shadingPath());
+  alignas(64) uint32_t localOut[kPrimaryHitBlock];  // the sample each is shaded at
+  alignas(64) double footprintX[kPrimaryHitBlock],
+      footprintY[kPrimaryHitBlock];  // image position of the footprint
   assignments.clear();
-  // The chunk's hits into the tile's samples, then its colours.
+  // The block's hits into the tile's samples, then its colours.
   const auto flush = [&] {
-    primaryShadeHits(primaryConstants_, scene_, setups_.data(), winnerOut, positionOut, footprintOut, count,
-                     hits.data(), requests.data());
-    for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = hits[r];
-    shadePrimaryHits(shader_, requests.data(), count, samples.color.data(), localOut, shadingPath());
+    batch.run();
+    const size_t count = batch.size();
+    for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = batch.hit(r);
+    kernel.shade(batch.hits(footprintX, footprintY, localOut), samples.color.data());
     n.shadedSamples += count;
-    count = 0;
+    batch.clear();
   };
   const auto addRequest = [&](uint32_t win, uint32_t local, const glm::dvec2& pos,
                               const glm::dvec2& footprint) {
-    winnerOut[count] = win;
-    localOut[count] = local;
-    positionOut[count] = pos;
-    footprintOut[count] = footprint;
-    if (++count == kChunk) flush();
+    const size_t k = batch.size();
+    localOut[k] = local;
+    footprintX[k] = footprint.x;
+    footprintY[k] = footprint.y;
+    batch.add(win, pos.x, pos.y);
+    if (batch.full()) flush();
   };
   const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
   std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, local)
@@ -125,7 +114,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
       }
     }
   }
-  if (count > 0) flush();
+  if (batch.size() > 0) flush();
   // After every chunk: a source sample's colour is final.
   for (const Assignment& a : assignments) samples.color[a.local] = samples.color[a.source];
 

@@ -16,44 +16,6 @@
 #include "common/run_lanes-inl.h"
 #include "raster/primary_samples.h"
 
-#ifndef RASTRAY_PRIMARY_SAMPLES_LANES
-#define RASTRAY_PRIMARY_SAMPLES_LANES
-namespace rastray {
-namespace primary_detail {
-
-constexpr size_t kBlock = 64;  // a multiple of every target's double lane count (2, 4, 8)
-
-// The fused pass's block (primaryShadeHits). Consecutive samples mostly
-// lie on one setup, so what is constant along a run of them (the setup's
-// planes, the stored triangle's plane) is stored once per run in a table,
-// and each lane holds only its position and its run: a vector of lanes on
-// one run reads the table as broadcasts, a vector across runs gathers.
-struct FusedBlock {
-  size_t lanes = 0;
-  alignas(64) double x[kBlock], y[kBlock];
-  alignas(64) int64_t run[kBlock];  // non-decreasing within the block
-  // Per run: the interpolation's inputs as SampleBlock's, then the stored
-  // triangle's plane as the refinement reads it (RefinePlaneLanes).
-  alignas(64) double x0[kBlock], y0[kBlock];
-  alignas(64) double iw0[kBlock], iwx[kBlock], iwy[kBlock];
-  alignas(64) double dw0[kBlock], dwx[kBlock], dwy[kBlock];
-  alignas(64) double b10[kBlock], b1x[kBlock], b1y[kBlock];
-  alignas(64) double b20[kBlock], b2x[kBlock], b2y[kBlock];
-  alignas(64) double e1x[kBlock], e1y[kBlock], e1z[kBlock], e2x[kBlock], e2y[kBlock], e2z[kBlock];
-  alignas(64) double sx[kBlock], sy[kBlock], sz[kBlock], qx[kBlock], qy[kBlock], qz[kBlock];
-  alignas(64) double e2DotQ[kBlock], slot1[kBlock], slot2[kBlock];
-  // Out, per lane: interpolated depth and barycentrics, the ray's
-  // direction, the refined barycentrics and 1 where they replace the
-  // interpolated ones.
-  alignas(64) double depth[kBlock], b1[kBlock], b2[kBlock];
-  alignas(64) double dirX[kBlock], dirY[kBlock], dirZ[kBlock];
-  alignas(64) double rb1[kBlock], rb2[kBlock], refined[kBlock];
-};
-
-}  // namespace primary_detail
-}  // namespace rastray
-#endif
-
 HWY_BEFORE_NAMESPACE();
 namespace rastray {
 namespace HWY_NAMESPACE {
@@ -161,85 +123,136 @@ void primarySamplesReference(const PrimaryRayConstants& camera, const TriangleSe
   }
 }
 
+PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups)
+    : camera_(camera),
+      scene_(scene),
+      setups_(setups),
+      block_(std::make_unique<primary_detail::FusedBlock>()) {}
+
+PrimaryBatch::~PrimaryBatch() = default;
+
+// A new run: its setup's planes and its stored triangle's plane.
+void PrimaryBatch::startRun(uint32_t winner) {
+  primary_detail::FusedBlock& b = *block_;
+  lastWinner_ = winner;
+  const size_t r = runs_++;
+  const TriangleSetup& t = setups_[winner];
+  runSetup_[r] = &t;
+  b.x0[r] = t.depth.x0, b.y0[r] = t.depth.y0;
+  b.iw0[r] = t.invW.v0, b.iwx[r] = t.invW.dx, b.iwy[r] = t.invW.dy;
+  b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
+  b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
+  b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
+  if (t.instance != planeInstance_ || t.triangle != planeTriangle_) {
+    // glm: the same bits as intersectTrianglePlane's memo.
+    const TrianglePlane plane = trianglePlane(scene_, t.instance, t.triangle);
+    e1_ = plane.e1;
+    e2_ = plane.e2;
+    s_ = camera_.eye - plane.a;
+    q_ = glm::cross(s_, plane.e1);
+    e2DotQ_ = glm::dot(plane.e2, q_);
+    slot1_ = double(plane.slot1);
+    slot2_ = double(plane.slot2);
+    planeInstance_ = t.instance;
+    planeTriangle_ = t.triangle;
+  }
+  b.e1x[r] = e1_.x, b.e1y[r] = e1_.y, b.e1z[r] = e1_.z;
+  b.e2x[r] = e2_.x, b.e2y[r] = e2_.y, b.e2z[r] = e2_.z;
+  b.sx[r] = s_.x, b.sy[r] = s_.y, b.sz[r] = s_.z;
+  b.qx[r] = q_.x, b.qy[r] = q_.y, b.qz[r] = q_.z;
+  b.e2DotQ[r] = e2DotQ_;
+  b.slot1[r] = slot1_;
+  b.slot2[r] = slot2_;
+  runInstance_[r] = t.instance;
+  runTriangle_[r] = t.triangle;
+}
+
+void PrimaryBatch::run() {
+  primary_detail::FusedBlock& b = *block_;
+  if (used_ == 0) return;
+  if (camera_.perspective) {
+    // Padding: the last run again, at the image origin; never read back.
+    const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(SampleLanes)();
+    b.lanes = (used_ + vectorLanes - 1) / vectorLanes * vectorLanes;
+    for (size_t k = used_; k < b.lanes; ++k) {
+      b.x[k] = b.y[k] = 0.0;
+      b.run[k] = int64_t(runs_ - 1);
+    }
+    HWY_DYNAMIC_DISPATCH(LanesFusedPrimary)(&b, &camera_);
+    for (size_t k = 0; k < used_; ++k) {
+      const bool refined = b.refined[k] != 0.0;
+      kb1_[k] = float(refined ? b.rb1[k] : b.b1[k]);
+      kb2_[k] = float(refined ? b.rb2[k] : b.b2[k]);
+      run32_[k] = int32_t(b.run[k]);
+    }
+    return;
+  }
+  // Orthographic rays: the reference steps, then the batched refinement.
+  const PrimaryRays primary(*camera_.camera);
+  SampleHit hits[primary_detail::kBlock];
+  Ray rays[primary_detail::kBlock];
+  ShadeHit refined[primary_detail::kBlock];
+  const glm::dvec2 unused[primary_detail::kBlock] = {};
+  for (size_t k = 0; k < used_; ++k) {
+    const glm::dvec2 pos(b.x[k], b.y[k]);
+    hits[k] = interpolatedSampleHit(*runSetup_[b.run[k]], pos);
+    rays[k] = primary(pos);
+  }
+  refinePrimaryHits(scene_, rays, hits, unused, used_, refined);
+  for (size_t k = 0; k < used_; ++k) {
+    // Exact in double: hit(k) rounds them back to the same floats.
+    b.depth[k] = double(hits[k].depth);
+    b.b1[k] = double(hits[k].b1);
+    b.b2[k] = double(hits[k].b2);
+    b.dirX[k] = refined[k].direction.x;
+    b.dirY[k] = refined[k].direction.y;
+    b.dirZ[k] = refined[k].direction.z;
+    kb1_[k] = refined[k].b1;
+    kb2_[k] = refined[k].b2;
+    run32_[k] = int32_t(b.run[k]);
+  }
+}
+
+PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footprintY,
+                                   const uint32_t* colorIndex) const {
+  PrimaryHitBlock h;
+  h.count = used_;
+  h.run = run32_;
+  h.runInstance = runInstance_;
+  h.runTriangle = runTriangle_;
+  h.dirX = block_->dirX;
+  h.dirY = block_->dirY;
+  h.dirZ = block_->dirZ;
+  h.b1 = kb1_;
+  h.b2 = kb2_;
+  h.footprintX = footprintX;
+  h.footprintY = footprintY;
+  h.colorIndex = colorIndex;
+  return h;
+}
+
 void primaryShadeHits(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
                       const uint32_t* winners, const glm::dvec2* positions, const glm::dvec2* footprints,
                       size_t count, SampleHit* hits, ShadeHit* out) {
-  if (!camera.perspective) {
-    // Orthographic rays: the reference, then the batched refinement.
-    thread_local std::vector<Ray> rays;
-    rays.resize(count);
-    primarySamplesReference(camera, setups, winners, positions, count, hits, rays.data());
-    refinePrimaryHits(scene, rays.data(), hits, footprints, count, out);
-    return;
-  }
-  using primary_detail::kBlock;
-  thread_local primary_detail::FusedBlock b;
-  const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(SampleLanes)();
-  // The current stored triangle's plane, with the eye-dependent terms as
-  // intersectTrianglePlane's memo computes them (glm: the same bits).
-  uint32_t planeInstance = kNoId, planeTriangle = kNoId;
-  TrianglePlane plane{};
-  glm::dvec3 s(0.0), q(0.0);
-  double e2DotQ = 0.0;
-  const TriangleSetup* runSetup[kBlock];
-  for (size_t first = 0; first < count; first += kBlock) {
-    const size_t used = std::min(kBlock, count - first);
-    int64_t runs = 0;
-    uint32_t lastWinner = 0;  // a run starts at k = 0 whatever it holds
+  const std::unique_ptr<PrimaryBatch> batch = std::make_unique<PrimaryBatch>(camera, scene, setups);
+  for (size_t first = 0; first < count; first += primary_detail::kBlock) {
+    const size_t used = std::min(primary_detail::kBlock, count - first);
+    for (size_t k = 0; k < used; ++k)
+      batch->add(winners[first + k], positions[first + k].x, positions[first + k].y);
+    batch->run();
+    const PrimaryHitBlock h = batch->hits(nullptr, nullptr, nullptr);
     for (size_t k = 0; k < used; ++k) {
-      const uint32_t win = winners[first + k];
-      const glm::dvec2& p = positions[first + k];
-      b.x[k] = p.x, b.y[k] = p.y;
-      if (win != lastWinner || runs == 0) {
-        // A new run: its setup's planes and its stored triangle's plane.
-        lastWinner = win;
-        const int64_t r = runs++;
-        const TriangleSetup& t = setups[win];
-        runSetup[r] = &t;
-        b.x0[r] = t.depth.x0, b.y0[r] = t.depth.y0;
-        b.iw0[r] = t.invW.v0, b.iwx[r] = t.invW.dx, b.iwy[r] = t.invW.dy;
-        b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
-        b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
-        b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
-        if (t.instance != planeInstance || t.triangle != planeTriangle) {
-          plane = trianglePlane(scene, t.instance, t.triangle);
-          s = camera.eye - plane.a;
-          q = glm::cross(s, plane.e1);
-          e2DotQ = glm::dot(plane.e2, q);
-          planeInstance = t.instance;
-          planeTriangle = t.triangle;
-        }
-        b.e1x[r] = plane.e1.x, b.e1y[r] = plane.e1.y, b.e1z[r] = plane.e1.z;
-        b.e2x[r] = plane.e2.x, b.e2y[r] = plane.e2.y, b.e2z[r] = plane.e2.z;
-        b.sx[r] = s.x, b.sy[r] = s.y, b.sz[r] = s.z;
-        b.qx[r] = q.x, b.qy[r] = q.y, b.qz[r] = q.z;
-        b.e2DotQ[r] = e2DotQ;
-        b.slot1[r] = double(plane.slot1);
-        b.slot2[r] = double(plane.slot2);
-      }
-      b.run[k] = runs - 1;
-    }
-    // Padding: the last run again, at the image origin; never read back.
-    b.lanes = (used + vectorLanes - 1) / vectorLanes * vectorLanes;
-    for (size_t k = used; k < b.lanes; ++k) {
-      b.x[k] = b.y[k] = 0.0;
-      b.run[k] = runs - 1;
-    }
-    HWY_DYNAMIC_DISPATCH(LanesFusedPrimary)(&b, &camera);
-    for (size_t k = 0; k < used; ++k) {
-      const TriangleSetup& t = *runSetup[b.run[k]];
-      const SampleHit h{t.instance, t.triangle, float(b.depth[k]), float(b.b1[k]), float(b.b2[k])};
-      hits[first + k] = h;
+      hits[first + k] = batch->hit(k);
       ShadeHit& r = out[first + k];
-      r.instance = h.instance;
-      r.triangle = h.triangle;
-      const bool refined = b.refined[k] != 0.0;
-      r.b1 = refined ? float(b.rb1[k]) : h.b1;
-      r.b2 = refined ? float(b.rb2[k]) : h.b2;
-      r.direction = glm::dvec3(b.dirX[k], b.dirY[k], b.dirZ[k]);
+      r.instance = h.runInstance[h.run[k]];
+      r.triangle = h.runTriangle[h.run[k]];
+      r.b1 = h.b1[k];
+      r.b2 = h.b2[k];
+      r.direction = glm::dvec3(h.dirX[k], h.dirY[k], h.dirZ[k]);
       r.footprintPosition = footprints[first + k];
       r.throughput = 1.0f;
     }
+    batch->clear();
   }
 }
 

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 #include <glm/glm.hpp>
 
@@ -53,6 +54,101 @@ void primarySamplesReference(const PrimaryRayConstants& camera, const TriangleSe
 void primaryShadeHits(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
                       const uint32_t* winners, const glm::dvec2* positions, const glm::dvec2* footprints,
                       size_t count, SampleHit* hits, ShadeHit* out);
+
+namespace primary_detail {
+
+constexpr size_t kBlock = kPrimaryHitBlock;  // a multiple of every target's double lane count (2, 4, 8)
+
+// The fused pass's block (PrimaryBatch). Consecutive samples mostly lie on
+// one setup, so what is constant along a run of them (the setup's planes,
+// the stored triangle's plane) is stored once per run in a table, and each
+// lane holds only its position and its run: a vector of lanes on one run
+// reads the table as broadcasts, a vector across runs gathers.
+struct FusedBlock {
+  size_t lanes = 0;
+  alignas(64) double x[kBlock], y[kBlock];
+  alignas(64) int64_t run[kBlock];  // non-decreasing within the block
+  // Per run: the interpolation's inputs, then the stored triangle's plane
+  // as the refinement reads it (RefinePlaneLanes).
+  alignas(64) double x0[kBlock], y0[kBlock];
+  alignas(64) double iw0[kBlock], iwx[kBlock], iwy[kBlock];
+  alignas(64) double dw0[kBlock], dwx[kBlock], dwy[kBlock];
+  alignas(64) double b10[kBlock], b1x[kBlock], b1y[kBlock];
+  alignas(64) double b20[kBlock], b2x[kBlock], b2y[kBlock];
+  alignas(64) double e1x[kBlock], e1y[kBlock], e1z[kBlock], e2x[kBlock], e2y[kBlock], e2z[kBlock];
+  alignas(64) double sx[kBlock], sy[kBlock], sz[kBlock], qx[kBlock], qy[kBlock], qz[kBlock];
+  alignas(64) double e2DotQ[kBlock], slot1[kBlock], slot2[kBlock];
+  // Out, per lane: interpolated depth and barycentrics, the ray's
+  // direction, the refined barycentrics and 1 where they replace the
+  // interpolated ones.
+  alignas(64) double depth[kBlock], b1[kBlock], b2[kBlock];
+  alignas(64) double dirX[kBlock], dirY[kBlock], dirZ[kBlock];
+  alignas(64) double rb1[kBlock], rb2[kBlock], refined[kBlock];
+};
+
+}  // namespace primary_detail
+
+// The fused pass a block of up to kPrimaryHitBlock samples at a time, the
+// block filled by the caller sample by sample (the winner loop: no
+// per-sample request arrays), its results handed to the shading kernel as
+// struct of arrays (PrimaryHitBlock: no ShadeHit per sample). The same
+// bits as primaryShadeHits, which runs through it.
+class PrimaryBatch {
+ public:
+  PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups);
+  ~PrimaryBatch();
+  PrimaryBatch(const PrimaryBatch&) = delete;
+  PrimaryBatch& operator=(const PrimaryBatch&) = delete;
+
+  size_t size() const { return used_; }
+  bool full() const { return used_ == primary_detail::kBlock; }
+
+  // Adds the sample at image position (x, y), won by setups[winner].
+  void add(uint32_t winner, double x, double y) {
+    const size_t k = used_++;
+    block_->x[k] = x;
+    block_->y[k] = y;
+    if (winner != lastWinner_ || runs_ == 0) startRun(winner);
+    block_->run[k] = int64_t(runs_ - 1);
+  }
+
+  // Runs the added samples through the lanes (perspective) or the scalar
+  // reference steps (orthographic); then hit(k) and hits() hold their
+  // results until clear().
+  void run();
+  // The interpolated hit of sample k (primaryShadeHits' `hits`).
+  SampleHit hit(size_t k) const {
+    const TriangleSetup& t = *runSetup_[block_->run[k]];
+    return {t.instance, t.triangle, float(block_->depth[k]), float(block_->b1[k]), float(block_->b2[k])};
+  }
+  // The refined hits for the kernel; footprints and colour indices are the
+  // caller's (per sample, in the order added).
+  PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex) const;
+  void clear() {
+    used_ = 0;
+    runs_ = 0;
+  }
+
+ private:
+  void startRun(uint32_t winner);
+
+  const PrimaryRayConstants& camera_;
+  const Scene& scene_;
+  const TriangleSetup* setups_;
+  std::unique_ptr<primary_detail::FusedBlock> block_;
+  size_t used_ = 0, runs_ = 0;
+  uint32_t lastWinner_ = 0;
+  const TriangleSetup* runSetup_[primary_detail::kBlock];
+  // Per run and per sample, for the kernel (after run()).
+  uint32_t runInstance_[primary_detail::kBlock], runTriangle_[primary_detail::kBlock];
+  alignas(64) int32_t run32_[primary_detail::kBlock];
+  alignas(64) float kb1_[primary_detail::kBlock], kb2_[primary_detail::kBlock];
+  // The current stored triangle's plane, with the eye-dependent terms as
+  // intersectTrianglePlane's memo computes them.
+  uint32_t planeInstance_ = kNoId, planeTriangle_ = kNoId;
+  glm::dvec3 e1_{0.0}, e2_{0.0}, s_{0.0}, q_{0.0};
+  double e2DotQ_ = 0.0, slot1_ = 0.0, slot2_ = 0.0;
+};
 
 // TileRenderer::interpolatedHit: depth and barycentrics at `pos` from the
 // setup's planes, rounded to float.
