@@ -54,6 +54,14 @@ struct LaneBlock {
   alignas(64) float n1X[kBlock], n1Y[kBlock], n1Z[kBlock];
   alignas(64) float n2X[kBlock], n2Y[kBlock], n2Z[kBlock];
   alignas(64) float diffuseWeight[kBlock];  // (1 − w)(1 − t)
+  // The material's base colour, emission and alpha (BLEND: base alpha;
+  // else 1), read by every lane while `colourPerLane` is false (no lane
+  // of the block needs its own: no texture, vertex colour or visibility
+  // callback), else the per-lane values above are.
+  alignas(64) float runAlbedoR[kBlock], runAlbedoG[kBlock], runAlbedoB[kBlock];
+  alignas(64) float runEmitR[kBlock], runEmitG[kBlock], runEmitB[kBlock];
+  alignas(64) float runAlpha[kBlock];
+  bool colourPerLane = false;
   // Per run, in double: the face normal (memoised) and the corner positions.
   alignas(64) double ngXd[kBlock], ngYd[kBlock], ngZd[kBlock];
   alignas(64) double p0X[kBlock], p0Y[kBlock], p0Z[kBlock];
@@ -290,18 +298,23 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto invPi = hn::Set(d, eyeLight ? 1.0f : float(0.31830988618379067154));
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto diffuse = RunLanes<decltype(d)>(d, b->run, i)(b->diffuseWeight);
+    const RunLanes<decltype(d)> get(d, b->run, i);
+    const auto diffuse = get(b->diffuseWeight);
     const auto hasDiffuse = hn::Gt(diffuse, zero);
-    const auto alpha = hn::Load(d, b->alpha + i);
-    const auto channel = [&](const float* albedo, const float* sum, const float* emit, float* out) {
-      const auto direct = hn::Mul(hn::Load(d, albedo + i), hn::Mul(hn::Load(d, sum + i), invPi));
-      const auto e = hn::Load(d, emit + i);
+    // The lane's own colours, or its run's (the same values).
+    const bool perLane = b->colourPerLane;
+    const auto read = [&](const float* lane, const float* run) {
+      return perLane ? hn::Load(d, lane + i) : get(run);
+    };
+    const auto alpha = read(b->alpha, b->runAlpha);
+    const auto channel = [&](const auto& albedo, const float* sum, const auto& e, float* out) {
+      const auto direct = hn::Mul(albedo, hn::Mul(hn::Load(d, sum + i), invPi));
       const auto L = hn::IfThenElse(hasDiffuse, hn::Add(e, hn::Mul(diffuse, direct)), e);
       hn::Store(hn::Mul(L, alpha), d, out + i);
     };
-    channel(b->albedoR, b->sumR, b->emitR, b->outR);
-    channel(b->albedoG, b->sumG, b->emitG, b->outG);
-    channel(b->albedoB, b->sumB, b->emitB, b->outB);
+    channel(read(b->albedoR, b->runAlbedoR), b->sumR, read(b->emitR, b->runEmitR), b->outR);
+    channel(read(b->albedoG, b->runAlbedoG), b->sumG, read(b->emitG, b->runEmitG), b->outG);
+    channel(read(b->albedoB, b->runAlbedoB), b->sumB, read(b->emitB, b->runEmitB), b->outB);
     hn::Store(alpha, d, b->outA + i);
   }
 }
@@ -454,8 +467,9 @@ class BlockShader {
 
   // Gathers hit `h` (to be written to `*out`) into the next lane.
   void add(const ShadeHit& h, const Material& m, glm::vec4* out) {
-    const size_t i = block_.used++;
     LaneBlock& b = block_;
+    colourPerLane();
+    const size_t i = b.used++;
     outputs_[i] = out;
     // Consecutive hits mostly share a triangle: its data is looked up once
     // per run (the same values, so the lane does not depend on the run).
@@ -540,15 +554,15 @@ class BlockShader {
     std::copy_n(h.dirZ + first, n, b.dirZd + i0);
     std::copy_n(h.b1 + first, n, b.b1 + i0);
     std::copy_n(h.b2 + first, n, b.b2 + i0);
-    const glm::vec4 base = m.baseColorFactor;
-    const glm::vec3 emit = m.emissive;
-    std::fill_n(b.albedoR + i0, n, base.r);
-    std::fill_n(b.albedoG + i0, n, base.g);
-    std::fill_n(b.albedoB + i0, n, base.b);
-    std::fill_n(b.emitR + i0, n, emit.r);
-    std::fill_n(b.emitG + i0, n, emit.g);
-    std::fill_n(b.emitB + i0, n, emit.b);
-    std::fill_n(b.alpha + i0, n, m.alphaMode == AlphaMode::Blend ? base.a : 1.0f);
+    if (b.colourPerLane) {
+      std::fill_n(b.albedoR + i0, n, b.runAlbedoR[r]);
+      std::fill_n(b.albedoG + i0, n, b.runAlbedoG[r]);
+      std::fill_n(b.albedoB + i0, n, b.runAlbedoB[r]);
+      std::fill_n(b.emitR + i0, n, b.runEmitR[r]);
+      std::fill_n(b.emitG + i0, n, b.runEmitG[r]);
+      std::fill_n(b.emitB + i0, n, b.runEmitB[r]);
+      std::fill_n(b.alpha + i0, n, b.runAlpha[r]);
+    }
     for (size_t k = 0; k < n; ++k) outputs_[i0 + k] = &colors[h.colorIndex[first + k]];
   }
 
@@ -596,6 +610,7 @@ class BlockShader {
     for (size_t i = 0; i < b.used; ++i) *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
     b.used = 0;
     b.runs = 0;
+    b.colourPerLane = false;
   }
 
  private:
@@ -635,6 +650,25 @@ class BlockShader {
     b.p0X[r] = run_.p0.x, b.p0Y[r] = run_.p0.y, b.p0Z[r] = run_.p0.z;
     b.p1X[r] = run_.p1.x, b.p1Y[r] = run_.p1.y, b.p1Z[r] = run_.p1.z;
     b.p2X[r] = run_.p2.x, b.p2Y[r] = run_.p2.y, b.p2Z[r] = run_.p2.z;
+    // Shader::baseColor and emission without texture or vertex colours.
+    const glm::vec4 base = m.baseColorFactor;
+    b.runAlbedoR[r] = base.r, b.runAlbedoG[r] = base.g, b.runAlbedoB[r] = base.b;
+    b.runEmitR[r] = m.emissive.r, b.runEmitG[r] = m.emissive.g, b.runEmitB[r] = m.emissive.b;
+    b.runAlpha[r] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
+  }
+
+  // From here on the block's lanes read their own colours: those gathered
+  // so far get their run's.
+  void colourPerLane() {
+    LaneBlock& b = block_;
+    if (b.colourPerLane) return;
+    b.colourPerLane = true;
+    for (size_t i = 0; i < b.used; ++i) {
+      const int32_t r = b.run[i];
+      b.albedoR[i] = b.runAlbedoR[r], b.albedoG[i] = b.runAlbedoG[r], b.albedoB[i] = b.runAlbedoB[r];
+      b.emitR[i] = b.runEmitR[r], b.emitG[i] = b.runEmitG[r], b.emitB[i] = b.runEmitB[r];
+      b.alpha[i] = b.runAlpha[r];
+    }
   }
 
   void startRun(uint32_t instance, uint32_t triangle) {
@@ -663,7 +697,7 @@ class BlockShader {
     for (size_t i = b.used; i < b.lanes; ++i) {
       b.dirXd[i] = b.dirYd[i] = 0.0;
       b.dirZd[i] = -1.0;
-      b.run[i] = int32_t(b.runs - 1);  // the last run's normals and corners; no colour below
+      b.run[i] = int32_t(b.runs - 1);  // the last run's normals, corners (and colours, per run)
       b.run64[i] = int64_t(b.runs - 1);
       b.b1[i] = b.b2[i] = 0.0f;
       b.albedoR[i] = b.albedoG[i] = b.albedoB[i] = 0.0f;

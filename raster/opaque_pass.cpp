@@ -58,12 +58,17 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   alignas(64) double footprintX[kPrimaryHitBlock],
       footprintY[kPrimaryHitBlock];  // image position of the footprint
   assignments.clear();
-  // The block's hits into the tile's samples, then its colours.
+  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
+  // The block's hits into the tile's samples, then its colours. At
+  // shading rate sample the footprint is at the sample: the batch's own
+  // positions.
+  const double* const fpX = pixelRate ? footprintX : batch.x();
+  const double* const fpY = pixelRate ? footprintY : batch.y();
   const auto flush = [&] {
     batch.run();
     const size_t count = batch.size();
     for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = batch.hit(r);
-    kernel.shade(batch.hits(footprintX, footprintY, localOut), samples.color.data());
+    kernel.shade(batch.hits(fpX, fpY, localOut), samples.color.data());
     n.shadedSamples += count;
     batch.clear();
   };
@@ -76,10 +81,33 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     batch.add(win, pos.x, pos.y);
     if (batch.full()) flush();
   };
-  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
+  if (!pixelRate) {
+    // Shading rate sample: every winner is shaded at its sample.
+    const glm::dvec2* const grid = grid_.positions.data();
+    for (int py = rect.y0; py < rect.y1; ++py) {
+      const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
+      uint32_t local = index(rect.x0, py, 0);
+      const double y = double(py);
+      for (int px = rect.x0; px < rect.x1; ++px) {
+        const double x = double(px);
+        for (int s = 0; s < spp; ++s, ++local) {
+          const uint32_t win = *rowWinners++;
+          if (win == kNoSetup) {
+            samples.color[local] = glm::vec4(0.0f);
+            samples.front[local] = SampleHit{};
+            continue;
+          }
+          localOut[batch.size()] = local;
+          batch.add(win, x + grid[s].x, y + grid[s].y);  // corner + grid position, as glm adds them
+          if (batch.full()) flush();
+        }
+      }
+    }
+  }
   std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, local)
-  for (int py = rect.y0; py < rect.y1; ++py) {
-    // The row's samples are consecutive in both the target and the tile.
+  for (int py = pixelRate ? rect.y0 : rect.y1; py < rect.y1; ++py) {
+    // Shading rate pixel. The row's samples are consecutive in both the
+    // target and the tile.
     const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
     uint32_t local = index(rect.x0, py, 0);
     for (int px = rect.x0; px < rect.x1; ++px) {
@@ -94,10 +122,6 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
           continue;
         }
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
-        if (!pixelRate) {
-          addRequest(win, local, pos, pos);
-          continue;
-        }
         const TriangleSetup& t = setups_[win];
         auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
                                [&](const auto& e) { return e.first == t.id(); });

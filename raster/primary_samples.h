@@ -101,6 +101,9 @@ class PrimaryBatch {
   PrimaryBatch& operator=(const PrimaryBatch&) = delete;
 
   size_t size() const { return used_; }
+  // The added samples' image positions, in the order added.
+  const double* x() const { return block_->x; }
+  const double* y() const { return block_->y; }
   bool full() const { return used_ == primary_detail::kBlock; }
 
   // Adds the sample at image position (x, y), won by setups[winner].
