@@ -83,24 +83,19 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   };
   if (!pixelRate) {
     // Shading rate sample: every winner is shaded at its sample.
-    const glm::dvec2* const grid = grid_.positions.data();
+    const size_t rowSamples = size_t(rect.x1 - rect.x0) * size_t(spp);
     for (int py = rect.y0; py < rect.y1; ++py) {
       const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
-      uint32_t local = index(rect.x0, py, 0);
-      const double y = double(py);
-      for (int px = rect.x0; px < rect.x1; ++px) {
-        const double x = double(px);
-        for (int s = 0; s < spp; ++s, ++local) {
-          const uint32_t win = *rowWinners++;
-          if (win == kNoSetup) {
-            samples.color[local] = glm::vec4(0.0f);
-            samples.front[local] = SampleHit{};
-            continue;
-          }
-          localOut[batch.size()] = local;
-          batch.add(win, x + grid[s].x, y + grid[s].y);  // corner + grid position, as glm adds them
-          if (batch.full()) flush();
-        }
+      const uint32_t local = index(rect.x0, py, 0);
+      for (size_t i = 0; i < rowSamples; ++i) {
+        if (rowWinners[i] != kNoSetup) continue;
+        samples.color[local + i] = glm::vec4(0.0f);
+        samples.front[local + i] = SampleHit{};
+      }
+      for (size_t i = 0; i < rowSamples;) {
+        i = batch.addRow(rowWinners, i, rowSamples, spp, rect.x0, py, grid_.positions.data(), local,
+                         localOut);
+        if (batch.full()) flush();
       }
     }
   }

@@ -131,11 +131,44 @@ PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene
 
 PrimaryBatch::~PrimaryBatch() = default;
 
-// A new run: its setup's planes and its stored triangle's plane.
-void PrimaryBatch::startRun(uint32_t winner) {
+size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int spp, int x0, int y,
+                            const glm::dvec2* grid, uint32_t local0, uint32_t* localOut) {
+  // The batch's state in locals (registers) for the loop.
   primary_detail::FusedBlock& b = *block_;
-  lastWinner_ = winner;
-  const size_t r = runs_++;
+  size_t used = used_, runs = runs_;
+  uint32_t last = lastWinner_;
+  const double py = double(y);
+  size_t i = first;
+  int s = int(first % size_t(spp));
+  double px = double(x0 + int(first / size_t(spp)));
+  for (; i < n && used < primary_detail::kBlock; ++i) {
+    const uint32_t win = winners[i];
+    if (win != kNoSetup) {
+      if (win != last || runs == 0) {
+        fillRun(runs++, win);
+        last = win;
+      }
+      // corner + grid position, as glm adds them
+      b.x[used] = px + grid[s].x;
+      b.y[used] = py + grid[s].y;
+      b.run[used] = int64_t(runs - 1);
+      localOut[used] = local0 + uint32_t(i);
+      ++used;
+    }
+    if (++s == spp) {
+      s = 0;
+      px += 1.0;
+    }
+  }
+  used_ = used;
+  runs_ = runs;
+  lastWinner_ = last;
+  return i;
+}
+
+// Run r: its setup's planes and its stored triangle's plane.
+void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
+  primary_detail::FusedBlock& b = *block_;
   const TriangleSetup& t = setups_[winner];
   runSetup_[r] = &t;
   b.x0[r] = t.depth.x0, b.y0[r] = t.depth.y0;

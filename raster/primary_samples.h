@@ -20,6 +20,7 @@
 #include "common/hit.h"
 #include "common/scene.h"
 #include "common/shading_kernel.h"
+#include "raster/coverage.h"
 #include "raster/setup.h"
 
 namespace rastray {
@@ -111,9 +112,20 @@ class PrimaryBatch {
     const size_t k = used_++;
     block_->x[k] = x;
     block_->y[k] = y;
-    if (winner != lastWinner_ || runs_ == 0) startRun(winner);
+    if (winner != lastWinner_ || runs_ == 0) {
+      fillRun(runs_++, winner);
+      lastWinner_ = winner;
+    }
     block_->run[k] = int64_t(runs_ - 1);
   }
+
+  // Adds the winners of samples [first, n) of one tile row: entry i is
+  // sample i % spp of pixel x0 + i / spp in row y, at (x0 + i / spp, y) +
+  // grid[i % spp], tile sample local0 + i, whose index goes to
+  // localOut[k] for the batch's sample k; kNoSetup entries are skipped.
+  // Stops when the block is full; returns where it stopped.
+  size_t addRow(const uint32_t* winners, size_t first, size_t n, int spp, int x0, int y,
+                const glm::dvec2* grid, uint32_t local0, uint32_t* localOut);
 
   // Runs the added samples through the lanes (perspective) or the scalar
   // reference steps (orthographic); then hit(k) and hits() hold their
@@ -121,8 +133,9 @@ class PrimaryBatch {
   void run();
   // The interpolated hit of sample k (primaryShadeHits' `hits`).
   SampleHit hit(size_t k) const {
-    const TriangleSetup& t = *runSetup_[block_->run[k]];
-    return {t.instance, t.triangle, float(block_->depth[k]), float(block_->b1[k]), float(block_->b2[k])};
+    const int64_t r = block_->run[k];
+    return {runInstance_[r], runTriangle_[r], float(block_->depth[k]), float(block_->b1[k]),
+            float(block_->b2[k])};
   }
   // The refined hits for the kernel; footprints and colour indices are the
   // caller's (per sample, in the order added).
@@ -133,7 +146,7 @@ class PrimaryBatch {
   }
 
  private:
-  void startRun(uint32_t winner);
+  void fillRun(size_t r, uint32_t winner);  // run r's table entry
 
   const PrimaryRayConstants& camera_;
   const Scene& scene_;
