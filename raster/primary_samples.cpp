@@ -54,9 +54,16 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     hn::Store(hn::Mul(plane(b->b10, b->b1x, b->b1y), inv), d, b->b1 + i);
     hn::Store(hn::Mul(plane(b->b20, b->b2x, b->b2y), inv), d, b->b2 + i);
 
-    const auto ndcX = hn::Sub(hn::Div(hn::Mul(two, x), width), one);
-    const auto ndcY = hn::Sub(one, hn::Div(hn::Mul(two, y), height));
-    const auto vx = hn::Mul(ndcX, sx), vy = hn::Mul(ndcY, sy);
+    hn::Vec<decltype(d)> vx, vy;
+    if (b->haveView) {
+      vx = hn::Load(d, b->vx + i);
+      vy = hn::Load(d, b->vy + i);
+    } else {
+      const auto ndcX = hn::Sub(hn::Div(hn::Mul(two, x), width), one);
+      const auto ndcY = hn::Sub(one, hn::Div(hn::Mul(two, y), height));
+      vx = hn::Mul(ndcX, sx);
+      vy = hn::Mul(ndcY, sy);
+    }
     const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), one));
     const auto wx = hn::Add(hn::Add(hn::Mul(m0x, vx), hn::Mul(m1x, vy)), cx);
     const auto wy = hn::Add(hn::Add(hn::Mul(m0y, vx), hn::Mul(m1y, vy)), cy);
@@ -127,12 +134,39 @@ PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene
     : camera_(camera),
       scene_(scene),
       setups_(setups),
-      block_(std::make_unique<primary_detail::FusedBlock>()) {}
+      block_(std::make_unique<primary_detail::FusedBlock>()) {
+  block_->haveView = true;  // until add() says otherwise
+}
 
 PrimaryBatch::~PrimaryBatch() = default;
 
 size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int spp, int x0, int y,
                             const glm::dvec2* grid, uint32_t local0, uint32_t* localOut) {
+  // The view-plane vector of every sample of the row, as the lanes would
+  // compute it (ndcFromImage, then · scale): per column and sample once
+  // per tile, per sample once per row.
+  const size_t columns = n / size_t(spp) + 1;
+  if (columnX0_ != x0 || columnSpp_ != spp || columnView_.size() < columns * size_t(spp)) {
+    columnX0_ = x0;
+    columnSpp_ = spp;
+    columnView_.resize(columns * size_t(spp));
+    for (size_t c = 0; c < columns; ++c)
+      for (int s = 0; s < spp; ++s) {
+        const double x = double(x0 + int(c)) + grid[s].x;
+        columnView_[c * size_t(spp) + size_t(s)] = ((2.0 * x) / camera_.width - 1.0) * camera_.scale.x;
+      }
+  }
+  if (rowY_ != y || rowSpp_ != spp || rowView_.empty()) {
+    rowY_ = y;
+    rowSpp_ = spp;
+    rowView_.resize(size_t(spp));
+    for (int s = 0; s < spp; ++s) {
+      const double yy = double(y) + grid[s].y;
+      rowView_[size_t(s)] = (1.0 - (2.0 * yy) / camera_.height) * camera_.scale.y;
+    }
+  }
+  const double* const columnView = columnView_.data();
+  const double* const rowView = rowView_.data();
   // The batch's state in locals (registers) for the loop.
   primary_detail::FusedBlock& b = *block_;
   size_t used = used_, runs = runs_;
@@ -152,6 +186,8 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
       b.x[used] = px + grid[s].x;
       b.y[used] = py + grid[s].y;
       b.run[used] = int64_t(runs - 1);
+      b.vx[used] = columnView[i];
+      b.vy[used] = rowView[s];
       localOut[used] = local0 + uint32_t(i);
       ++used;
     }

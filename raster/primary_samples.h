@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -69,6 +70,11 @@ struct FusedBlock {
   size_t lanes = 0;
   alignas(64) double x[kBlock], y[kBlock];
   alignas(64) int64_t run[kBlock];  // non-decreasing within the block
+  // The view-plane vector (ndc · scale) per lane, when every lane has it
+  // (`haveView`: added by addRow from per-tile tables, the operations of
+  // the lanes); else the lanes compute it from x and y.
+  bool haveView = false;
+  alignas(64) double vx[kBlock], vy[kBlock];
   // Per run: the interpolation's inputs, then the stored triangle's plane
   // as the refinement reads it (RefinePlaneLanes).
   alignas(64) double x0[kBlock], y0[kBlock];
@@ -109,6 +115,7 @@ class PrimaryBatch {
 
   // Adds the sample at image position (x, y), won by setups[winner].
   void add(uint32_t winner, double x, double y) {
+    block_->haveView = false;
     const size_t k = used_++;
     block_->x[k] = x;
     block_->y[k] = y;
@@ -143,6 +150,7 @@ class PrimaryBatch {
   void clear() {
     used_ = 0;
     runs_ = 0;
+    block_->haveView = true;
   }
 
  private:
@@ -162,6 +170,12 @@ class PrimaryBatch {
   // The current stored triangle's plane, with the eye-dependent terms as
   // intersectTrianglePlane's memo computes them.
   uint32_t planeInstance_ = kNoId, planeTriangle_ = kNoId;
+  // addRow's view-plane vectors: per column of the last x0 and sample
+  // (vx), per sample of the last row (vy).
+  std::vector<double> columnView_;
+  int columnX0_ = 0, columnSpp_ = 0;
+  std::vector<double> rowView_;
+  int rowY_ = 0, rowSpp_ = 0;
   glm::dvec3 e1_{0.0}, e2_{0.0}, s_{0.0}, q_{0.0};
   double e2DotQ_ = 0.0, slot1_ = 0.0, slot2_ = 0.0;
 };
