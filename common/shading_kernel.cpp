@@ -671,7 +671,21 @@ class BlockShader {
     }
   }
 
+  // run_ for (instance, triangle): from the cache of recent triangles
+  // (a function of the triangle alone: the same values), else computed.
+  // Small triangles give runs of one or two samples, and a tile's next
+  // row meets the same triangles again.
   void startRun(uint32_t instance, uint32_t triangle) {
+    TriangleRun& cached = runCache_[(triangle * 2654435761u + instance * 40503u) >> (32 - kRunCacheBits)];
+    if (cached.instance == instance && cached.triangle == triangle) {
+      run_ = cached;
+      return;
+    }
+    computeRun(instance, triangle);
+    cached = run_;
+  }
+
+  void computeRun(uint32_t instance, uint32_t triangle) {
     TriangleRun& r = run_;
     r.instance = instance;
     r.triangle = triangle;
@@ -715,6 +729,8 @@ class BlockShader {
   bool textured_ = false;
   std::vector<LaneLight> lights_;
   TriangleRun run_;
+  static constexpr int kRunCacheBits = 7;
+  TriangleRun runCache_[size_t(1) << kRunCacheBits];  // empty: kNoId
   LaneBlock block_;
   glm::vec4* outputs_[kBlock];
   SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback

@@ -134,7 +134,8 @@ PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene
     : camera_(camera),
       scene_(scene),
       setups_(setups),
-      block_(std::make_unique<primary_detail::FusedBlock>()) {
+      block_(std::make_unique<primary_detail::FusedBlock>()),
+      planes_(std::make_unique<Plane[]>(size_t(1) << kPlaneCacheBits)) {
   block_->haveView = true;  // until add() says otherwise
 }
 
@@ -212,26 +213,27 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
   b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
   b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
   b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
-  if (t.instance != planeInstance_ || t.triangle != planeTriangle_) {
+  Plane& p = planes_[(t.triangle * 2654435761u + t.instance * 40503u) >> (32 - kPlaneCacheBits)];
+  if (t.instance != p.instance || t.triangle != p.triangle) {
     // glm: the same bits as intersectTrianglePlane's memo.
     const TrianglePlane plane = trianglePlane(scene_, t.instance, t.triangle);
-    e1_ = plane.e1;
-    e2_ = plane.e2;
-    s_ = camera_.eye - plane.a;
-    q_ = glm::cross(s_, plane.e1);
-    e2DotQ_ = glm::dot(plane.e2, q_);
-    slot1_ = double(plane.slot1);
-    slot2_ = double(plane.slot2);
-    planeInstance_ = t.instance;
-    planeTriangle_ = t.triangle;
+    p.e1 = plane.e1;
+    p.e2 = plane.e2;
+    p.s = camera_.eye - plane.a;
+    p.q = glm::cross(p.s, plane.e1);
+    p.e2DotQ = glm::dot(plane.e2, p.q);
+    p.slot1 = double(plane.slot1);
+    p.slot2 = double(plane.slot2);
+    p.instance = t.instance;
+    p.triangle = t.triangle;
   }
-  b.e1x[r] = e1_.x, b.e1y[r] = e1_.y, b.e1z[r] = e1_.z;
-  b.e2x[r] = e2_.x, b.e2y[r] = e2_.y, b.e2z[r] = e2_.z;
-  b.sx[r] = s_.x, b.sy[r] = s_.y, b.sz[r] = s_.z;
-  b.qx[r] = q_.x, b.qy[r] = q_.y, b.qz[r] = q_.z;
-  b.e2DotQ[r] = e2DotQ_;
-  b.slot1[r] = slot1_;
-  b.slot2[r] = slot2_;
+  b.e1x[r] = p.e1.x, b.e1y[r] = p.e1.y, b.e1z[r] = p.e1.z;
+  b.e2x[r] = p.e2.x, b.e2y[r] = p.e2.y, b.e2z[r] = p.e2.z;
+  b.sx[r] = p.s.x, b.sy[r] = p.s.y, b.sz[r] = p.s.z;
+  b.qx[r] = p.q.x, b.qy[r] = p.q.y, b.qz[r] = p.q.z;
+  b.e2DotQ[r] = p.e2DotQ;
+  b.slot1[r] = p.slot1;
+  b.slot2[r] = p.slot2;
   runInstance_[r] = t.instance;
   runTriangle_[r] = t.triangle;
 }

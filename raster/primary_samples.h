@@ -167,17 +167,24 @@ class PrimaryBatch {
   uint32_t runInstance_[primary_detail::kBlock], runTriangle_[primary_detail::kBlock];
   alignas(64) int32_t run32_[primary_detail::kBlock];
   alignas(64) float kb1_[primary_detail::kBlock], kb2_[primary_detail::kBlock];
-  // The current stored triangle's plane, with the eye-dependent terms as
-  // intersectTrianglePlane's memo computes them.
-  uint32_t planeInstance_ = kNoId, planeTriangle_ = kNoId;
+  // The stored triangle's plane as a run needs it (with the eye-dependent
+  // terms as intersectTrianglePlane's memo computes them), for recent
+  // triangles: a function of the triangle and the eye alone, cached by
+  // triangle. Small triangles give runs of one or two samples, and a
+  // tile's next row meets the same triangles again.
+  struct Plane {
+    uint32_t instance = kNoId, triangle = kNoId;
+    glm::dvec3 e1{0.0}, e2{0.0}, s{0.0}, q{0.0};
+    double e2DotQ = 0.0, slot1 = 0.0, slot2 = 0.0;
+  };
+  static constexpr int kPlaneCacheBits = 7;
+  std::unique_ptr<Plane[]> planes_;
   // addRow's view-plane vectors: per column of the last x0 and sample
   // (vx), per sample of the last row (vy).
   std::vector<double> columnView_;
   int columnX0_ = 0, columnSpp_ = 0;
   std::vector<double> rowView_;
   int rowY_ = 0, rowSpp_ = 0;
-  glm::dvec3 e1_{0.0}, e2_{0.0}, s_{0.0}, q_{0.0};
-  double e2DotQ_ = 0.0, slot1_ = 0.0, slot2_ = 0.0;
 };
 
 // TileRenderer::interpolatedHit: depth and barycentrics at `pos` from the
