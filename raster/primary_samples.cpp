@@ -25,9 +25,9 @@ size_t SampleLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 // Per lane: TriangleSetup::viewDepthAt and baryAt (PlaneCoefficients::at:
 // (v0 + dx·(x − x0)) + dy·(y − y0)), then PrimaryRays::operator() for a
-// perspective camera (ndcFromImage, the view-plane vector and its glm
-// length ((x² + y²) + 1, the z² of −1 being exactly 1), worldFromView's
-// columns, glm::normalize (v · (1 / √(v·v))) and 1 / length), then the
+// perspective camera (ndcFromImage, the view-plane vector, worldFromView's
+// columns, glm::normalize (v · (1 / √(v·v))); the ray's depthPerT is not
+// needed, see below), then the
 // refinement on the stored triangle's plane (RefineOnPlane) with that ray,
 // in registers: the same operations as primarySamplesReference followed by
 // refinePrimaryHits.
@@ -64,7 +64,6 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
       vx = hn::Mul(ndcX, sx);
       vy = hn::Mul(ndcY, sy);
     }
-    const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), one));
     const auto wx = hn::Add(hn::Add(hn::Mul(m0x, vx), hn::Mul(m1x, vy)), cx);
     const auto wy = hn::Add(hn::Add(hn::Mul(m0y, vx), hn::Mul(m1y, vy)), cy);
     const auto wz = hn::Add(hn::Add(hn::Mul(m0z, vx), hn::Mul(m1z, vy)), cz);
@@ -83,7 +82,13 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     pl.e2DotQ = get(b->e2DotQ);
     pl.slot1 = get(b->slot1), pl.slot2 = get(b->slot2);
     hn::Vec<decltype(d)> rb1, rb2;
-    const auto ok = RefineOnPlane(d, dirX, dirY, dirZ, hn::Div(one, length), pl, &rb1, &rb2);
+    // depthPerT = 1 / length, with length = √((vx² + vy²) + 1) ≥ 1 (or
+    // +inf, or NaN with NaN directions), only enters RefineOnPlane's test
+    // that t · depthPerT is finite: with depthPerT in [0, 1] that holds
+    // exactly when t is finite, which it also tests. So 1 gives the same
+    // mask without a square root and a division per lane (tested against
+    // refinePrimaryHit, which uses the ray's own depthPerT).
+    const auto ok = RefineOnPlane(d, dirX, dirY, dirZ, one, pl, &rb1, &rb2);
     hn::Store(rb1, d, b->rb1 + i);
     hn::Store(rb2, d, b->rb2 + i);
     hn::Store(hn::IfThenElseZero(ok, one), d, b->refined + i);
