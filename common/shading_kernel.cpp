@@ -358,7 +358,10 @@ HWY_AFTER_NAMESPACE();
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <optional>
+#include <type_traits>
 
 #include "common/optics.h"
 #include "common/primary_refinement.h"
@@ -460,6 +463,7 @@ class BlockShader {
         vectorLanes_(HWY_DYNAMIC_DISPATCH(KernelLanes)()),
         visible_(shader.visibility() && !shader.eyeLight() && !shader.scene().lights.empty()) {
     for (const Light& light : scene_.lights) lights_.push_back(laneLight(light));
+    std::fill_n(runKeys_, size_t(1) << kRunCacheBits, ~uint64_t(0));
   }
 
   bool full() const { return block_.used == kBlock; }
@@ -617,7 +621,7 @@ class BlockShader {
   // What every lane on one triangle reads: its instance, corner indices,
   // positions (double, exact), face normal (double and rounded) and
   // authored corner normals (zero when the instance has none).
-  struct TriangleRun {
+  struct TriangleRun {  // trivially copyable (the run cache copies its bytes)
     uint32_t instance = kNoId, triangle = kNoId;
     const Instance* inst = nullptr;
     glm::uvec3 corners{0};
@@ -627,6 +631,7 @@ class BlockShader {
     bool authored = false;
     glm::vec3 n0{0.0f}, n1{0.0f}, n2{0.0f};
   };
+  static_assert(std::is_trivially_copyable<TriangleRun>::value, "the run cache copies its bytes");
 
   // The lanes that follow are on (instance, triangle) with material `m`:
   // a new entry in the block's run table unless the last one is the same
@@ -676,13 +681,16 @@ class BlockShader {
   // Small triangles give runs of one or two samples, and a tile's next
   // row meets the same triangles again.
   void startRun(uint32_t instance, uint32_t triangle) {
-    TriangleRun& cached = runCache_[(triangle * 2654435761u + instance * 40503u) >> (32 - kRunCacheBits)];
-    if (cached.instance == instance && cached.triangle == triangle) {
-      run_ = cached;
+    const size_t slot = (triangle * 2654435761u + instance * 40503u) >> (32 - kRunCacheBits);
+    const uint64_t key = uint64_t(instance) << 32 | triangle;
+    unsigned char* const cached = runCache_.get() + slot * sizeof(TriangleRun);
+    if (runKeys_[slot] == key) {
+      std::memcpy(static_cast<void*>(&run_), cached, sizeof(TriangleRun));
       return;
     }
     computeRun(instance, triangle);
-    cached = run_;
+    runKeys_[slot] = key;
+    std::memcpy(cached, static_cast<const void*>(&run_), sizeof(TriangleRun));
   }
 
   void computeRun(uint32_t instance, uint32_t triangle) {
@@ -730,7 +738,12 @@ class BlockShader {
   std::vector<LaneLight> lights_;
   TriangleRun run_;
   static constexpr int kRunCacheBits = 7;
-  TriangleRun runCache_[size_t(1) << kRunCacheBits];  // empty: kNoId
+  // (instance << 32 | triangle) of each entry of runCache_; all ones: none
+  // (built once per BlockShader: only the keys are set up front).
+  uint64_t runKeys_[size_t(1) << kRunCacheBits];
+  // The entries' bytes (TriangleRun is trivially copyable), not
+  // constructed: only entries whose key is set are read.
+  std::unique_ptr<unsigned char[]> runCache_{new unsigned char[sizeof(TriangleRun) << kRunCacheBits]};
   LaneBlock block_;
   glm::vec4* outputs_[kBlock];
   SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback

@@ -277,7 +277,11 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
                     winners[i + size_t(k)] = index;
                     writtenMax = std::max(writtenMax, rowKeys[k]);
                   }
-                  const uint32_t n = uint32_t(__builtin_popcount(passMask));
+                  // Eight bits counted in registers (the build has no
+                  // POPCNT: __builtin_popcount is a library call).
+                  uint32_t n = passMask - ((passMask >> 1) & 0x55u);
+                  n = (n & 0x33u) + ((n >> 2) & 0x33u);
+                  n = (n + (n >> 4)) & 0x0Fu;
                   counters->samplesPassed += n;
                   written += n;
                   continue;

@@ -139,8 +139,12 @@ PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene
     : camera_(camera),
       scene_(scene),
       setups_(setups),
-      block_(std::make_unique<primary_detail::FusedBlock>()),
-      planes_(std::make_unique<Plane[]>(size_t(1) << kPlaneCacheBits)) {
+      // Not value-initialised (about 30 KB a tile): every lane and run
+      // entry is written before it is read.
+      block_(new primary_detail::FusedBlock),
+      planes_(new Plane[size_t(1) << kPlaneCacheBits]),
+      planeKeys_(new uint64_t[size_t(1) << kPlaneCacheBits]) {
+  std::fill_n(planeKeys_.get(), size_t(1) << kPlaneCacheBits, kNoPlane);
   block_->haveView = true;  // until add() says otherwise
 }
 
@@ -218,8 +222,11 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
   b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
   b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
   b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
-  Plane& p = planes_[(t.triangle * 2654435761u + t.instance * 40503u) >> (32 - kPlaneCacheBits)];
-  if (t.instance != p.instance || t.triangle != p.triangle) {
+  const size_t slot = (t.triangle * 2654435761u + t.instance * 40503u) >> (32 - kPlaneCacheBits);
+  Plane& p = planes_[slot];
+  const uint64_t key = t.id();
+  if (planeKeys_[slot] != key) {
+    planeKeys_[slot] = key;
     // glm: the same bits as intersectTrianglePlane's memo.
     const TrianglePlane plane = trianglePlane(scene_, t.instance, t.triangle);
     p.e1 = plane.e1;
@@ -229,8 +236,6 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
     p.e2DotQ = glm::dot(plane.e2, p.q);
     p.slot1 = double(plane.slot1);
     p.slot2 = double(plane.slot2);
-    p.instance = t.instance;
-    p.triangle = t.triangle;
   }
   b.e1x[r] = p.e1.x, b.e1y[r] = p.e1.y, b.e1z[r] = p.e1.z;
   b.e2x[r] = p.e2.x, b.e2y[r] = p.e2.y, b.e2z[r] = p.e2.z;

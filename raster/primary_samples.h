@@ -173,12 +173,13 @@ class PrimaryBatch {
   // triangle. Small triangles give runs of one or two samples, and a
   // tile's next row meets the same triangles again.
   struct Plane {
-    uint32_t instance = kNoId, triangle = kNoId;
-    glm::dvec3 e1{0.0}, e2{0.0}, s{0.0}, q{0.0};
-    double e2DotQ = 0.0, slot1 = 0.0, slot2 = 0.0;
+    glm::dvec3 e1, e2, s, q;
+    double e2DotQ, slot1, slot2;
   };
   static constexpr int kPlaneCacheBits = 7;
-  std::unique_ptr<Plane[]> planes_;
+  std::unique_ptr<Plane[]> planes_;        // uninitialised where planeKeys_ holds kNoPlane
+  std::unique_ptr<uint64_t[]> planeKeys_;  // (instance << 32 | triangle) of each entry
+  static constexpr uint64_t kNoPlane = ~uint64_t(0);
   // addRow's view-plane vectors: per column of the last x0 and sample
   // (vx), per sample of the last row (vy).
   std::vector<double> columnView_;
