@@ -19,8 +19,10 @@ void TileRenderer::opaquePass(const TileRect& rect, const std::vector<uint32_t>&
   std::function<bool(const TriangleSetup&, int, int, int)> alphaTest;
   if (analysis_.alphaTest)
     alphaTest = [this](const TriangleSetup& t, int px, int py, int s) { return alphaCovered(t, px, py, s); };
+  // render() hands pass 1 a cleared rect (a fresh tile target, or the
+  // frame's target cleared or new).
   rasterDepthPass(setups_, bin, grid_, rect, options_.depthFormat, options_.depthFunc, alphaTest, trace,
-                  target, &n.opaque, coveragePath());
+                  target, &n.opaque, coveragePath(), /*clearedRect=*/true);
 }
 
 void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,
