@@ -35,25 +35,22 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   // storage is only sized, never filled first.
   samples.color.resize(index.count());
   samples.front.resize(index.count());
-  // The tile's winning samples in two steps, a chunk of them at a time:
-  // gather the hits to shade (in pixel and sample order) and compute, per
-  // block of them in double lanes, the interpolated hit, the primary ray
-  // and the hit refined on its stored triangle's plane (primaryShadeHits:
-  // primarySamples' and refinePrimaryHits' bits, raster/primary_samples.h);
-  // then shade them through the shading kernel (common/shading_kernel.h),
-  // the one the ray caster shades its primary hits with, straight into the
-  // tile's colours. A hit's colour does not depend on its chunk (the
-  // kernel's lane independence). At shading rate pixel a sample takes the colour of the first
-  // sample of its pixel on the same triangle. Per-thread scratch: no
-  // allocation per tile once grown.
+  // The tile's winning samples a block of kPrimaryHitBlock at a time, in
+  // pixel and sample order: the winner loop adds each to the fused pass's
+  // block (PrimaryBatch: the interpolated hit, the primary ray and the hit
+  // refined on its stored triangle's plane in double lanes, with
+  // primarySamplesReference's and refinePrimaryHit's bits,
+  // raster/primary_samples.h), whose results go as struct of arrays to the
+  // shading kernel (PrimaryHitShader, common/shading_kernel.h: the kernel
+  // the ray caster shades its primary hits with), straight into the
+  // tile's colours. A hit's colour does not depend on its block (the
+  // kernel's lane independence). At shading rate pixel a sample takes the
+  // colour of the first sample of its pixel on the same triangle.
   struct Assignment {
     uint32_t local;   // TileSampleIndex
     uint32_t source;  // the sample whose colour it takes
   };
   thread_local std::vector<Assignment> assignments;
-  // A block of winners at a time: the winner loop adds each to the fused
-  // pass's block (PrimaryBatch: interpolated hit, primary ray, refinement
-  // in double lanes), whose results go to the kernel as struct of arrays.
   PrimaryBatch batch(primaryConstants_, scene_, setups_.data());
   PrimaryHitShader kernel(shader_, shadingPath());
   alignas(64) uint32_t localOut[kPrimaryHitBlock];  // the sample each is shaded at
