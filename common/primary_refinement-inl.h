@@ -61,8 +61,15 @@ HWY_INLINE hwy::HWY_NAMESPACE::Mask<D> RefineOnPlane(D d, V dx, V dy, V dz, V de
   b2 = hn::IfThenElse(hn::Lt(b2, zero), zero, b2);
   const auto sum = hn::Add(b1, b2);
   const auto over = hn::Gt(sum, one);
-  *b1Out = hn::IfThenElse(over, hn::Div(b1, sum), b1);
-  *b2Out = hn::IfThenElse(over, hn::Div(b2, sum), b2);
+  if (hn::AllFalse(d, over)) {
+    // No lane beyond the edge (the usual case): the two divisions would be
+    // discarded in every lane.
+    *b1Out = b1;
+    *b2Out = b2;
+  } else {
+    *b1Out = hn::IfThenElse(over, hn::Div(b1, sum), b1);
+    *b2Out = hn::IfThenElse(over, hn::Div(b2, sum), b2);
+  }
   return ok;
 }
 

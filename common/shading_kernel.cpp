@@ -54,6 +54,14 @@ struct LaneBlock {
   alignas(64) float n1X[kBlock], n1Y[kBlock], n1Z[kBlock];
   alignas(64) float n2X[kBlock], n2Y[kBlock], n2Z[kBlock];
   alignas(64) float diffuseWeight[kBlock];  // (1 − w)(1 − t)
+  // The material's base colour, emission and alpha (BLEND: base alpha;
+  // else 1), read by every lane while `colourPerLane` is false (no lane
+  // of the block needs its own: no texture, vertex colour or visibility
+  // callback), else the per-lane values above are.
+  alignas(64) float runAlbedoR[kBlock], runAlbedoG[kBlock], runAlbedoB[kBlock];
+  alignas(64) float runEmitR[kBlock], runEmitG[kBlock], runEmitB[kBlock];
+  alignas(64) float runAlpha[kBlock];
+  bool colourPerLane = false;
   // Per run, in double: the face normal (memoised) and the corner positions.
   alignas(64) double ngXd[kBlock], ngYd[kBlock], ngZd[kBlock];
   alignas(64) double p0X[kBlock], p0Y[kBlock], p0Z[kBlock];
@@ -290,18 +298,23 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   const auto zero = hn::Zero(d);
   const auto invPi = hn::Set(d, eyeLight ? 1.0f : float(0.31830988618379067154));
   for (size_t i = 0; i < b->lanes; i += N) {
-    const auto diffuse = RunLanes<decltype(d)>(d, b->run, i)(b->diffuseWeight);
+    const RunLanes<decltype(d)> get(d, b->run, i);
+    const auto diffuse = get(b->diffuseWeight);
     const auto hasDiffuse = hn::Gt(diffuse, zero);
-    const auto alpha = hn::Load(d, b->alpha + i);
-    const auto channel = [&](const float* albedo, const float* sum, const float* emit, float* out) {
-      const auto direct = hn::Mul(hn::Load(d, albedo + i), hn::Mul(hn::Load(d, sum + i), invPi));
-      const auto e = hn::Load(d, emit + i);
+    // The lane's own colours, or its run's (the same values).
+    const bool perLane = b->colourPerLane;
+    const auto read = [&](const float* lane, const float* run) {
+      return perLane ? hn::Load(d, lane + i) : get(run);
+    };
+    const auto alpha = read(b->alpha, b->runAlpha);
+    const auto channel = [&](const auto& albedo, const float* sum, const auto& e, float* out) {
+      const auto direct = hn::Mul(albedo, hn::Mul(hn::Load(d, sum + i), invPi));
       const auto L = hn::IfThenElse(hasDiffuse, hn::Add(e, hn::Mul(diffuse, direct)), e);
       hn::Store(hn::Mul(L, alpha), d, out + i);
     };
-    channel(b->albedoR, b->sumR, b->emitR, b->outR);
-    channel(b->albedoG, b->sumG, b->emitG, b->outG);
-    channel(b->albedoB, b->sumB, b->emitB, b->outB);
+    channel(read(b->albedoR, b->runAlbedoR), b->sumR, read(b->emitR, b->runEmitR), b->outR);
+    channel(read(b->albedoG, b->runAlbedoG), b->sumG, read(b->emitG, b->runEmitG), b->outG);
+    channel(read(b->albedoB, b->runAlbedoB), b->sumB, read(b->emitB, b->runEmitB), b->outB);
     hn::Store(alpha, d, b->outA + i);
   }
 }
@@ -345,7 +358,10 @@ HWY_AFTER_NAMESPACE();
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <optional>
+#include <type_traits>
 
 #include "common/optics.h"
 #include "common/primary_refinement.h"
@@ -451,35 +467,21 @@ class BlockShader {
         vectorLanes_(HWY_DYNAMIC_DISPATCH(KernelLanes)()),
         visible_(shader.visibility() && !shader.eyeLight() && !shader.scene().lights.empty()) {
     for (const Light& light : scene_.lights) lights_.push_back(laneLight(light));
+    std::fill_n(runKeys_, size_t(1) << kRunCacheBits, ~uint64_t(0));
   }
 
   bool full() const { return block_.used == kBlock; }
+  size_t used() const { return block_.used; }
 
   // Gathers hit `h` (to be written to `*out`) into the next lane.
   void add(const ShadeHit& h, const Material& m, glm::vec4* out) {
-    const size_t i = block_.used++;
     LaneBlock& b = block_;
+    colourPerLane();
+    const size_t i = b.used++;
     outputs_[i] = out;
     // Consecutive hits mostly share a triangle: its data is looked up once
     // per run (the same values, so the lane does not depend on the run).
-    const bool newTriangle = h.instance != run_.instance || h.triangle != run_.triangle;
-    if (newTriangle) startRun(h.instance, h.triangle);
-    if (newTriangle || b.runs == 0) {
-      // The run's entry in the block's table.
-      const size_t r = b.runs++;
-      b.ngX[r] = run_.ngF.x;
-      b.ngY[r] = run_.ngF.y;
-      b.ngZ[r] = run_.ngF.z;
-      b.authored[r] = run_.authored ? 1.0f : 0.0f;
-      b.n0X[r] = run_.n0.x, b.n0Y[r] = run_.n0.y, b.n0Z[r] = run_.n0.z;
-      b.n1X[r] = run_.n1.x, b.n1Y[r] = run_.n1.y, b.n1Z[r] = run_.n1.z;
-      b.n2X[r] = run_.n2.x, b.n2Y[r] = run_.n2.y, b.n2Z[r] = run_.n2.z;
-      b.diffuseWeight[r] = (1.0f - m.mirrorWeight()) * (1.0f - m.transmission);
-      b.ngXd[r] = run_.ng.x, b.ngYd[r] = run_.ng.y, b.ngZd[r] = run_.ng.z;
-      b.p0X[r] = run_.p0.x, b.p0Y[r] = run_.p0.y, b.p0Z[r] = run_.p0.z;
-      b.p1X[r] = run_.p1.x, b.p1Y[r] = run_.p1.y, b.p1Z[r] = run_.p1.z;
-      b.p2X[r] = run_.p2.x, b.p2Y[r] = run_.p2.y, b.p2Z[r] = run_.p2.z;
-    }
+    enterRun(h.instance, h.triangle, m);
     b.run[i] = int32_t(b.runs - 1);
     b.run64[i] = int64_t(b.runs - 1);
     const Instance& inst = *run_.inst;
@@ -522,6 +524,54 @@ class BlockShader {
     b.emitG[i] = emit.g;
     b.emitB[i] = emit.b;
     b.alpha[i] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
+  }
+
+  // Gathers hits [first, end) of `h`, one run (one triangle, material
+  // `m`), the colour of hit k to colors[h.colorIndex[k]]; the block has
+  // room for them. The lanes get the values add() would give them; where
+  // neither a texture, vertex colours nor a visibility callback needs the
+  // hit's own surface, the base colour and emission are the run's.
+  void addRun(const PrimaryHitBlock& h, size_t first, size_t end, const Material& m, glm::vec4* colors) {
+    const uint32_t instance = h.runInstance[h.run[first]], triangle = h.runTriangle[h.run[first]];
+    if (&m != material_) {
+      material_ = &m;
+      textured_ = samplesTexture(shader_, m);
+    }
+    if (textured_ || visible_ || scene_.instances[instance].hasColors) {
+      for (size_t k = first; k < end; ++k) {
+        ShadeHit s;
+        s.instance = instance;
+        s.triangle = triangle;
+        s.b1 = h.b1[k];
+        s.b2 = h.b2[k];
+        s.direction = glm::dvec3(h.dirX[k], h.dirY[k], h.dirZ[k]);
+        s.footprintPosition = glm::dvec2(h.footprintX[k], h.footprintY[k]);
+        add(s, m, &colors[h.colorIndex[k]]);
+      }
+      return;
+    }
+    LaneBlock& b = block_;
+    enterRun(instance, triangle, m);
+    const size_t i0 = b.used, n = end - first;
+    b.used += n;
+    const int32_t r = int32_t(b.runs - 1);
+    std::fill_n(b.run + i0, n, r);
+    std::fill_n(b.run64 + i0, n, int64_t(r));
+    std::copy_n(h.dirX + first, n, b.dirXd + i0);
+    std::copy_n(h.dirY + first, n, b.dirYd + i0);
+    std::copy_n(h.dirZ + first, n, b.dirZd + i0);
+    std::copy_n(h.b1 + first, n, b.b1 + i0);
+    std::copy_n(h.b2 + first, n, b.b2 + i0);
+    if (b.colourPerLane) {
+      std::fill_n(b.albedoR + i0, n, b.runAlbedoR[r]);
+      std::fill_n(b.albedoG + i0, n, b.runAlbedoG[r]);
+      std::fill_n(b.albedoB + i0, n, b.runAlbedoB[r]);
+      std::fill_n(b.emitR + i0, n, b.runEmitR[r]);
+      std::fill_n(b.emitG + i0, n, b.runEmitG[r]);
+      std::fill_n(b.emitB + i0, n, b.runEmitB[r]);
+      std::fill_n(b.alpha + i0, n, b.runAlpha[r]);
+    }
+    for (size_t k = 0; k < n; ++k) outputs_[i0 + k] = &colors[h.colorIndex[first + k]];
   }
 
   // Shades the gathered lanes and writes their colours; empties the block.
@@ -568,13 +618,14 @@ class BlockShader {
     for (size_t i = 0; i < b.used; ++i) *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
     b.used = 0;
     b.runs = 0;
+    b.colourPerLane = false;
   }
 
  private:
   // What every lane on one triangle reads: its instance, corner indices,
   // positions (double, exact), face normal (double and rounded) and
   // authored corner normals (zero when the instance has none).
-  struct TriangleRun {
+  struct TriangleRun {  // trivially copyable (the run cache copies its bytes)
     uint32_t instance = kNoId, triangle = kNoId;
     const Instance* inst = nullptr;
     glm::uvec3 corners{0};
@@ -584,8 +635,69 @@ class BlockShader {
     bool authored = false;
     glm::vec3 n0{0.0f}, n1{0.0f}, n2{0.0f};
   };
+  static_assert(std::is_trivially_copyable<TriangleRun>::value, "the run cache copies its bytes");
 
+  // The lanes that follow are on (instance, triangle) with material `m`:
+  // a new entry in the block's run table unless the last one is the same
+  // triangle (the same values either way, so a lane does not depend on
+  // its neighbours).
+  void enterRun(uint32_t instance, uint32_t triangle, const Material& m) {
+    LaneBlock& b = block_;
+    const bool newTriangle = instance != run_.instance || triangle != run_.triangle;
+    if (newTriangle) startRun(instance, triangle);
+    if (!newTriangle && b.runs != 0) return;
+    const size_t r = b.runs++;
+    b.ngX[r] = run_.ngF.x;
+    b.ngY[r] = run_.ngF.y;
+    b.ngZ[r] = run_.ngF.z;
+    b.authored[r] = run_.authored ? 1.0f : 0.0f;
+    b.n0X[r] = run_.n0.x, b.n0Y[r] = run_.n0.y, b.n0Z[r] = run_.n0.z;
+    b.n1X[r] = run_.n1.x, b.n1Y[r] = run_.n1.y, b.n1Z[r] = run_.n1.z;
+    b.n2X[r] = run_.n2.x, b.n2Y[r] = run_.n2.y, b.n2Z[r] = run_.n2.z;
+    b.diffuseWeight[r] = (1.0f - m.mirrorWeight()) * (1.0f - m.transmission);
+    b.ngXd[r] = run_.ng.x, b.ngYd[r] = run_.ng.y, b.ngZd[r] = run_.ng.z;
+    b.p0X[r] = run_.p0.x, b.p0Y[r] = run_.p0.y, b.p0Z[r] = run_.p0.z;
+    b.p1X[r] = run_.p1.x, b.p1Y[r] = run_.p1.y, b.p1Z[r] = run_.p1.z;
+    b.p2X[r] = run_.p2.x, b.p2Y[r] = run_.p2.y, b.p2Z[r] = run_.p2.z;
+    // Shader::baseColor and emission without texture or vertex colours.
+    const glm::vec4 base = m.baseColorFactor;
+    b.runAlbedoR[r] = base.r, b.runAlbedoG[r] = base.g, b.runAlbedoB[r] = base.b;
+    b.runEmitR[r] = m.emissive.r, b.runEmitG[r] = m.emissive.g, b.runEmitB[r] = m.emissive.b;
+    b.runAlpha[r] = m.alphaMode == AlphaMode::Blend ? base.a : 1.0f;
+  }
+
+  // From here on the block's lanes read their own colours: those gathered
+  // so far get their run's.
+  void colourPerLane() {
+    LaneBlock& b = block_;
+    if (b.colourPerLane) return;
+    b.colourPerLane = true;
+    for (size_t i = 0; i < b.used; ++i) {
+      const int32_t r = b.run[i];
+      b.albedoR[i] = b.runAlbedoR[r], b.albedoG[i] = b.runAlbedoG[r], b.albedoB[i] = b.runAlbedoB[r];
+      b.emitR[i] = b.runEmitR[r], b.emitG[i] = b.runEmitG[r], b.emitB[i] = b.runEmitB[r];
+      b.alpha[i] = b.runAlpha[r];
+    }
+  }
+
+  // run_ for (instance, triangle): from the cache of recent triangles
+  // (a function of the triangle alone: the same values), else computed.
+  // Small triangles give runs of one or two samples, and a tile's next
+  // row meets the same triangles again.
   void startRun(uint32_t instance, uint32_t triangle) {
+    const size_t slot = (triangle * 2654435761u + instance * 40503u) >> (32 - kRunCacheBits);
+    const uint64_t key = uint64_t(instance) << 32 | triangle;
+    unsigned char* const cached = runCache_.get() + slot * sizeof(TriangleRun);
+    if (runKeys_[slot] == key) {
+      std::memcpy(static_cast<void*>(&run_), cached, sizeof(TriangleRun));
+      return;
+    }
+    computeRun(instance, triangle);
+    runKeys_[slot] = key;
+    std::memcpy(cached, static_cast<const void*>(&run_), sizeof(TriangleRun));
+  }
+
+  void computeRun(uint32_t instance, uint32_t triangle) {
     TriangleRun& r = run_;
     r.instance = instance;
     r.triangle = triangle;
@@ -611,7 +723,7 @@ class BlockShader {
     for (size_t i = b.used; i < b.lanes; ++i) {
       b.dirXd[i] = b.dirYd[i] = 0.0;
       b.dirZd[i] = -1.0;
-      b.run[i] = int32_t(b.runs - 1);  // the last run's normals and corners; no colour below
+      b.run[i] = int32_t(b.runs - 1);  // the last run's normals, corners (and colours, per run)
       b.run64[i] = int64_t(b.runs - 1);
       b.b1[i] = b.b2[i] = 0.0f;
       b.albedoR[i] = b.albedoG[i] = b.albedoB[i] = 0.0f;
@@ -629,6 +741,13 @@ class BlockShader {
   bool textured_ = false;
   std::vector<LaneLight> lights_;
   TriangleRun run_;
+  static constexpr int kRunCacheBits = 7;
+  // (instance << 32 | triangle) of each entry of runCache_; all ones: none
+  // (built once per BlockShader: only the keys are set up front).
+  uint64_t runKeys_[size_t(1) << kRunCacheBits];
+  // The entries' bytes (TriangleRun is trivially copyable), not
+  // constructed: only entries whose key is set are read.
+  std::unique_ptr<unsigned char[]> runCache_{new unsigned char[sizeof(TriangleRun) << kRunCacheBits]};
   LaneBlock block_;
   glm::vec4* outputs_[kBlock];
   SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback
@@ -667,6 +786,63 @@ void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, 
     if (block->full()) block->run();
   }
   if (block) block->run();
+}
+
+struct PrimaryHitShader::Impl {
+  Impl(const Shader& s, ShadingPath path)
+      : shader(s), reference(path == ShadingPath::Reference || s.options().referenceShading) {}
+  const Shader& shader;
+  const bool reference;
+  std::optional<BlockShader> block;  // built at the first lane, as in shadePrimaryHits
+  uint32_t runInstance = kNoId;      // the path is a function of the material: decided once per instance
+  const Material* material = nullptr;
+  bool scalar = false;
+};
+
+PrimaryHitShader::PrimaryHitShader(const Shader& shader, ShadingPath path)
+    : impl_(std::make_unique<Impl>(shader, path)) {}
+
+PrimaryHitShader::~PrimaryHitShader() = default;
+
+void PrimaryHitShader::shade(const PrimaryHitBlock& h, glm::vec4* colors) {
+  Impl& s = *impl_;
+  const auto shadeHit = [&](size_t k) {
+    ShadeHit one;
+    one.instance = h.runInstance[h.run[k]];
+    one.triangle = h.runTriangle[h.run[k]];
+    one.b1 = h.b1[k];
+    one.b2 = h.b2[k];
+    one.direction = glm::dvec3(h.dirX[k], h.dirY[k], h.dirZ[k]);
+    one.footprintPosition = glm::dvec2(h.footprintX[k], h.footprintY[k]);
+    colors[h.colorIndex[k]] = shadeReference(s.shader, one);
+  };
+  if (s.reference) {
+    for (size_t k = 0; k < h.count; ++k) shadeHit(k);
+    return;
+  }
+  for (size_t first = 0, end = 0; first < h.count; first = end) {
+    const int32_t run = h.run[first];
+    for (end = first + 1; end < h.count && h.run[end] == run; ++end) {
+    }
+    const uint32_t instance = h.runInstance[run];
+    if (instance != s.runInstance) {
+      s.runInstance = instance;
+      s.material = &s.shader.scene().materialOf(instance);
+      s.scalar = needsScalarShade(s.shader, *s.material);
+    }
+    if (s.scalar) {
+      for (size_t k = first; k < end; ++k) shadeHit(k);
+      continue;
+    }
+    if (!s.block) s.block.emplace(s.shader);
+    if (s.block->used() + (end - first) > kBlock) s.block->run();  // more hits than a block: in pieces
+    for (size_t piece = first; piece < end; piece += kBlock) {
+      const size_t pieceEnd = std::min(end, piece + kBlock);
+      if (piece > first) s.block->run();
+      s.block->addRun(h, piece, pieceEnd, *s.material, colors);
+    }
+  }
+  if (s.block) s.block->run();
 }
 
 void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,

@@ -65,6 +65,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -113,6 +114,45 @@ void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, 
 // (a tile's samples, without a contiguous copy in between).
 void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, glm::vec4* colors,
                       const uint32_t* colorIndex, ShadingPath path);
+
+// A block of at most kPrimaryHitBlock primary hits as struct of arrays,
+// in runs of consecutive hits on one triangle: what the rasterizer's fused
+// pass (raster/primary_samples.h) hands the kernel without building a
+// ShadeHit per hit. Hit i is ShadeHit{runInstance[run[i]],
+// runTriangle[run[i]], b1[i], b2[i], (dirX, dirY, dirZ)[i], (footprintX,
+// footprintY)[i], throughput 1}; its colour goes to colors[colorIndex[i]].
+constexpr size_t kPrimaryHitBlock = 64;
+struct PrimaryHitBlock {
+  size_t count = 0;
+  const int32_t* run = nullptr;                                    // per hit: its run, non-decreasing
+  const uint32_t* runInstance = nullptr;                           // per run
+  const uint32_t* runTriangle = nullptr;                           // per run
+  const double *dirX = nullptr, *dirY = nullptr, *dirZ = nullptr;  // per hit: unit, towards the surface
+  const float *b1 = nullptr, *b2 = nullptr;                        // per hit: refined
+  const double *footprintX = nullptr, *footprintY = nullptr;       // per hit: image position of the footprint
+  const uint32_t* colorIndex = nullptr;                            // per hit
+};
+
+// The kernel for blocks of hits (PrimaryHitBlock), built once per caller
+// (a tile) instead of per batch: the same colours, bit for bit, as
+// shadePrimaryHits on the same hits as ShadeHits (tested), with the
+// per-run values (triangle, material, base colour and emission where no
+// texture, vertex colour or visibility callback needs the hit's own)
+// stored once per run instead of per hit.
+class PrimaryHitShader {
+ public:
+  PrimaryHitShader(const Shader& shader, ShadingPath path);
+  ~PrimaryHitShader();
+  PrimaryHitShader(const PrimaryHitShader&) = delete;
+  PrimaryHitShader& operator=(const PrimaryHitShader&) = delete;
+
+  // Shades hits.count ≤ kPrimaryHitBlock hits into `colors`.
+  void shade(const PrimaryHitBlock& hits, glm::vec4* colors);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // The SIMD target HWY_DYNAMIC_DISPATCH runs the lanes on here (Highway's
 // name: AVX3, AVX2, SSE4, ...), for reports and tests.

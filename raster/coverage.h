@@ -184,12 +184,17 @@ inline uint32_t sampleDepthKey(const TriangleSetup& t, const SampleGrid& grid, D
 // empty request unless its pixel lies in `rect`) receives, at that pixel,
 // every triangle's setup and coverage (traceCoverage), each depth test
 // (key against the stored key and winner) and each MASK discard. `path`
-// picks the coverage walk (identical results).
+// picks the coverage walk (identical results). `clearedRect`: the
+// target's samples in `rect` all hold kClearDepthKey (a tile's fresh
+// target, as the camera pass gives it); the hierarchical depth test then
+// knows a block still holds a cleared sample while fewer samples were
+// written there than it has, without reading its keys (the same keys,
+// winners and counters).
 void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
                      const SampleGrid& grid, const TileRect& rect, DepthFormat format, DepthFunc func,
                      const std::function<bool(const TriangleSetup&, int px, int py, int s)>& alphaTest,
                      const TraceRequest& trace, DepthTarget* target, DepthPassCounters* counters,
-                     CoveragePath path = CoveragePath::Fast);
+                     CoveragePath path = CoveragePath::Fast, bool clearedRect = false);
 
 // Records t's setup (facing, snapped vertices and edge functions with their
 // fill-rule class, in fixed-point units of 1/unitsPerPixel pixel) and, at

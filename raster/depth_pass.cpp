@@ -12,7 +12,9 @@
 // not change the result; the triangles keep their bin order. The reference
 // path (CoveragePath::Reference) and the traced triangles run the scalar
 // per-sample loop in (py, px, s) order, without the hierarchical test.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -55,13 +57,14 @@ void traceDepthTest(TraceSink& sink, const std::vector<TriangleSetup>& setups, c
 // an upper bound, only a looser one).
 class BlockDepthBounds {
  public:
-  BlockDepthBounds(const DepthTarget& target, const TileRect& rect)
+  BlockDepthBounds(const DepthTarget& target, const TileRect& rect, bool cleared)
       : target_(target),
         rect_(rect),
         columns_((rect.x1 - rect.x0 + kCoverageBlock - 1) / kCoverageBlock),
         bound_(size_t(columns_) * size_t((rect.y1 - rect.y0 + kCoverageBlock - 1) / kCoverageBlock),
                kClearDepthKey),
-        stale_(bound_.size(), 1) {}
+        stale_(bound_.size(), 1),
+        writes_(bound_.size(), cleared ? 0u : UINT32_MAX) {}
 
   size_t block(int x, int y) const {
     return size_t((y - rect_.y0) / kCoverageBlock) * size_t(columns_) +
@@ -70,9 +73,15 @@ class BlockDepthBounds {
   // Whether every key stored in block b is nearer than the lowest key a
   // triangle can have there (lowestKey(), computed only when needed): a
   // stale bound that already decides it is not refreshed.
+  // A block of a cleared rect where fewer samples were written than it
+  // holds still has a sample at kClearDepthKey, so its bound is that key
+  // and nothing is culled there: known without refreshing (reading its
+  // keys), which small triangles would otherwise do once each. `spp`: the
+  // target's samples per pixel.
   template <typename F>
-  bool culls(size_t b, F lowestKey) {
+  bool culls(size_t b, int spp, F lowestKey) {
     if (bound_[b] == kClearDepthKey && !stale_[b]) return false;
+    if (writes_[b] < blockSamples(b, spp)) return false;
     const uint32_t lowest = lowestKey();
     if (lowest > bound_[b]) return true;
     if (!stale_[b]) return false;
@@ -80,6 +89,10 @@ class BlockDepthBounds {
     return lowest > bound_[b];
   }
   void markStale(size_t b) { stale_[b] = 1; }
+  // `n` samples of block b were written (by the fast walk, which counts).
+  void addWrites(size_t b, uint32_t n) {
+    writes_[b] = n > UINT32_MAX - writes_[b] ? UINT32_MAX : writes_[b] + n;
+  }
   // Every sample of block b was just written, the largest key being `key`.
   void setExact(size_t b, uint32_t key) {
     bound_[b] = key;
@@ -92,10 +105,15 @@ class BlockDepthBounds {
     return b.x == bx && b.y == by && b.w == std::min(kCoverageBlock, rect_.x1 - bx) &&
            b.h == std::min(kCoverageBlock, rect_.y1 - by);
   }
+  // Written by a walk that does not count its writes (reference, traced):
+  // their number is unknown, so the blocks are refreshed when asked.
   void markStale(const PixelBounds& r) {
     constexpr int B = kCoverageBlock;
     for (int y = rect_.y0 + (r.y0 - rect_.y0) / B * B; y <= r.y1; y += B)
-      for (int x = rect_.x0 + (r.x0 - rect_.x0) / B * B; x <= r.x1; x += B) stale_[block(x, y)] = 1;
+      for (int x = rect_.x0 + (r.x0 - rect_.x0) / B * B; x <= r.x1; x += B) {
+        stale_[block(x, y)] = 1;
+        writes_[block(x, y)] = UINT32_MAX;
+      }
   }
 
  private:
@@ -110,11 +128,22 @@ class BlockDepthBounds {
     stale_[b] = 0;
   }
 
+  // Samples of block b within the rect.
+  uint32_t blockSamples(size_t b, int spp) const {
+    const int x0 = rect_.x0 + int(b % size_t(columns_)) * kCoverageBlock;
+    const int y0 = rect_.y0 + int(b / size_t(columns_)) * kCoverageBlock;
+    return uint32_t(std::min(kCoverageBlock, rect_.x1 - x0) * std::min(kCoverageBlock, rect_.y1 - y0) * spp);
+  }
+
   const DepthTarget& target_;
   TileRect rect_;
   int columns_;
   std::vector<uint32_t> bound_;
   std::vector<uint8_t> stale_;
+  // Samples written per block since the pass began on a cleared rect (a
+  // count, not distinct samples; saturating; UINT32_MAX: unknown, and
+  // always so when the rect was not cleared).
+  std::vector<uint32_t> writes_;
 };
 
 // Whether none of the eight keys equals its stored key (then bit k of
@@ -152,14 +181,14 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
                      const SampleGrid& grid, const TileRect& rect, DepthFormat format, DepthFunc func,
                      const std::function<bool(const TriangleSetup&, int, int, int)>& alphaTest,
                      const TraceRequest& trace, DepthTarget* target, DepthPassCounters* counters,
-                     CoveragePath path) {
+                     CoveragePath path, bool clearedRect) {
   CoverageScratch scratch;
   const bool keysOnly = target->winners.empty();
   uint32_t* keys = target->keys.data();
   uint32_t* winners = target->winners.data();
   const int spp = grid.spp;
   const int64_t U = grid.unitsPerPixel;
-  BlockDepthBounds bounds(*target, rect);
+  BlockDepthBounds bounds(*target, rect, clearedRect);
   glm::dvec2 lowPos(1.0), highPos(0.0);
   for (const glm::dvec2& q : grid.positions) {
     lowPos = glm::min(lowPos, q);
@@ -231,8 +260,9 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         const BlockClass c = classifyBlock(t, scratch, U, b, lo);
         if (c == BlockClass::Reject) continue;
         const size_t hb = bounds.block(bx, by);
-        if (bounds.culls(
-                hb, [&] { return std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos)); }))
+        if (bounds.culls(hb, spp, [&] {
+              return std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos));
+            }))
           continue;
         // The same test as `test` above without the trace (not traced here).
         uint32_t written = 0, writtenMax = 0;
@@ -277,7 +307,11 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
                     winners[i + size_t(k)] = index;
                     writtenMax = std::max(writtenMax, rowKeys[k]);
                   }
-                  const uint32_t n = uint32_t(__builtin_popcount(passMask));
+                  // Eight bits counted in registers (the build has no
+                  // POPCNT: __builtin_popcount is a library call).
+                  uint32_t n = passMask - ((passMask >> 1) & 0x55u);
+                  n = (n & 0x33u) + ((n >> 2) & 0x33u);
+                  n = (n + (n >> 4)) & 0x0Fu;
                   counters->samplesPassed += n;
                   written += n;
                   continue;
@@ -287,6 +321,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
             }
           }
           if (written == 0) continue;
+          bounds.addWrites(hb, written);
           if (written == uint32_t(b.w * b.h * spp) && bounds.wholeBlock(b))
             bounds.setExact(hb, writtenMax);  // every key of the block is new
           else
@@ -304,7 +339,10 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
             testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s));
           }
         }
-        if (written != 0) bounds.markStale(hb);
+        if (written != 0) {
+          bounds.addWrites(hb, written);
+          bounds.markStale(hb);
+        }
       }
   }
 }

@@ -19,8 +19,10 @@ void TileRenderer::opaquePass(const TileRect& rect, const std::vector<uint32_t>&
   std::function<bool(const TriangleSetup&, int, int, int)> alphaTest;
   if (analysis_.alphaTest)
     alphaTest = [this](const TriangleSetup& t, int px, int py, int s) { return alphaCovered(t, px, py, s); };
+  // render() hands pass 1 a cleared rect (a fresh tile target, or the
+  // frame's target cleared or new).
   rasterDepthPass(setups_, bin, grid_, rect, options_.depthFormat, options_.depthFunc, alphaTest, trace,
-                  target, &n.opaque, coveragePath());
+                  target, &n.opaque, coveragePath(), /*clearedRect=*/true);
 }
 
 void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget& target,
@@ -33,64 +35,73 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   // storage is only sized, never filled first.
   samples.color.resize(index.count());
   samples.front.resize(index.count());
-  // The tile's winning samples in two steps, a chunk of them at a time:
-  // gather the hits to shade (in pixel and sample order) and compute, per
-  // block of them in double lanes, the interpolated hit, the primary ray
-  // and the hit refined on its stored triangle's plane (primaryShadeHits:
-  // primarySamples' and refinePrimaryHits' bits, raster/primary_samples.h);
-  // then shade them through the shading kernel (common/shading_kernel.h),
-  // the one the ray caster shades its primary hits with, straight into the
-  // tile's colours. A hit's colour does not depend on its chunk (the
-  // kernel's lane independence). At shading rate pixel a sample takes the colour of the first
-  // sample of its pixel on the same triangle. Per-thread scratch: no
-  // allocation per tile once grown.
+  // The tile's winning samples a block of kPrimaryHitBlock at a time, in
+  // pixel and sample order: the winner loop adds each to the fused pass's
+  // block (PrimaryBatch: the interpolated hit, the primary ray and the hit
+  // refined on its stored triangle's plane in double lanes, with
+  // primarySamplesReference's and refinePrimaryHit's bits,
+  // raster/primary_samples.h), whose results go as struct of arrays to the
+  // shading kernel (PrimaryHitShader, common/shading_kernel.h: the kernel
+  // the ray caster shades its primary hits with), straight into the
+  // tile's colours. A hit's colour does not depend on its block (the
+  // kernel's lane independence). At shading rate pixel a sample takes the
+  // colour of the first sample of its pixel on the same triangle.
   struct Assignment {
     uint32_t local;   // TileSampleIndex
     uint32_t source;  // the sample whose colour it takes
   };
-  thread_local std::vector<uint32_t> winners;       // setup per request
-  thread_local std::vector<glm::dvec2> positions;   // image position per request
-  thread_local std::vector<uint32_t> requestLocal;  // the sample a request is shaded at
-  thread_local std::vector<SampleHit> hits;         // interpolated, per request
-  thread_local std::vector<glm::dvec2> footprints;  // image position of the texture footprint
-  thread_local std::vector<ShadeHit> requests;      // refined
   thread_local std::vector<Assignment> assignments;
-  // Requests are shaded a chunk at a time as the loop gathers them, so a
-  // chunk's inputs, hits and refined requests stay in the core's caches
-  // (a whole tile's would not: about 0.7 MB at 1 spp). Sized once, filled
-  // through plain pointers (no push_back in the sample loop).
-  constexpr size_t kChunk = 256;
-  for (auto* v : {&winners, &requestLocal}) v->resize(kChunk);
-  for (auto* v : {&positions, &footprints}) v->resize(kChunk);
-  hits.resize(kChunk);
-  requests.resize(kChunk);
-  uint32_t* const winnerOut = winners.data();
-  uint32_t* const localOut = requestLocal.data();
-  glm::dvec2* const positionOut = positions.data();
-  glm::dvec2* const footprintOut = footprints.data();
-  size_t count = 0;
+  PrimaryBatch batch(primaryConstants_, scene_, setups_.data());
+  PrimaryHitShader kernel(shader_, shadingPath());
+  alignas(64) uint32_t localOut[kPrimaryHitBlock];  // the sample each is shaded at
+  alignas(64) double footprintX[kPrimaryHitBlock],
+      footprintY[kPrimaryHitBlock];  // image position of the footprint
   assignments.clear();
-  // The chunk's hits into the tile's samples, then its colours.
+  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
+  // The block's hits into the tile's samples, then its colours. At
+  // shading rate sample the footprint is at the sample: the batch's own
+  // positions.
+  const double* const fpX = pixelRate ? footprintX : batch.x();
+  const double* const fpY = pixelRate ? footprintY : batch.y();
   const auto flush = [&] {
-    primaryShadeHits(primaryConstants_, scene_, setups_.data(), winnerOut, positionOut, footprintOut, count,
-                     hits.data(), requests.data());
-    for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = hits[r];
-    shadePrimaryHits(shader_, requests.data(), count, samples.color.data(), localOut, shadingPath());
+    batch.run();
+    const size_t count = batch.size();
+    for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = batch.hit(r);
+    kernel.shade(batch.hits(fpX, fpY, localOut), samples.color.data());
     n.shadedSamples += count;
-    count = 0;
+    batch.clear();
   };
   const auto addRequest = [&](uint32_t win, uint32_t local, const glm::dvec2& pos,
                               const glm::dvec2& footprint) {
-    winnerOut[count] = win;
-    localOut[count] = local;
-    positionOut[count] = pos;
-    footprintOut[count] = footprint;
-    if (++count == kChunk) flush();
+    const size_t k = batch.size();
+    localOut[k] = local;
+    footprintX[k] = footprint.x;
+    footprintY[k] = footprint.y;
+    batch.add(win, pos.x, pos.y);
+    if (batch.full()) flush();
   };
-  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
+  if (!pixelRate) {
+    // Shading rate sample: every winner is shaded at its sample.
+    const size_t rowSamples = size_t(rect.x1 - rect.x0) * size_t(spp);
+    for (int py = rect.y0; py < rect.y1; ++py) {
+      const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
+      const uint32_t local = index(rect.x0, py, 0);
+      for (size_t i = 0; i < rowSamples; ++i) {
+        if (rowWinners[i] != kNoSetup) continue;
+        samples.color[local + i] = glm::vec4(0.0f);
+        samples.front[local + i] = SampleHit{};
+      }
+      for (size_t i = 0; i < rowSamples;) {
+        i = batch.addRow(rowWinners, i, rowSamples, spp, rect.x0, py, grid_.positions.data(), local,
+                         localOut);
+        if (batch.full()) flush();
+      }
+    }
+  }
   std::vector<std::pair<uint64_t, uint32_t>> pixelCache;  // shading rate pixel: (triangle, local)
-  for (int py = rect.y0; py < rect.y1; ++py) {
-    // The row's samples are consecutive in both the target and the tile.
+  for (int py = pixelRate ? rect.y0 : rect.y1; py < rect.y1; ++py) {
+    // Shading rate pixel. The row's samples are consecutive in both the
+    // target and the tile.
     const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
     uint32_t local = index(rect.x0, py, 0);
     for (int px = rect.x0; px < rect.x1; ++px) {
@@ -105,10 +116,6 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
           continue;
         }
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
-        if (!pixelRate) {
-          addRequest(win, local, pos, pos);
-          continue;
-        }
         const TriangleSetup& t = setups_[win];
         auto it = std::find_if(pixelCache.begin(), pixelCache.end(),
                                [&](const auto& e) { return e.first == t.id(); });
@@ -125,7 +132,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
       }
     }
   }
-  if (count > 0) flush();
+  if (batch.size() > 0) flush();
   // After every chunk: a source sample's colour is final.
   for (const Assignment& a : assignments) samples.color[a.local] = samples.color[a.source];
 

@@ -16,44 +16,6 @@
 #include "common/run_lanes-inl.h"
 #include "raster/primary_samples.h"
 
-#ifndef RASTRAY_PRIMARY_SAMPLES_LANES
-#define RASTRAY_PRIMARY_SAMPLES_LANES
-namespace rastray {
-namespace primary_detail {
-
-constexpr size_t kBlock = 64;  // a multiple of every target's double lane count (2, 4, 8)
-
-// The fused pass's block (primaryShadeHits). Consecutive samples mostly
-// lie on one setup, so what is constant along a run of them (the setup's
-// planes, the stored triangle's plane) is stored once per run in a table,
-// and each lane holds only its position and its run: a vector of lanes on
-// one run reads the table as broadcasts, a vector across runs gathers.
-struct FusedBlock {
-  size_t lanes = 0;
-  alignas(64) double x[kBlock], y[kBlock];
-  alignas(64) int64_t run[kBlock];  // non-decreasing within the block
-  // Per run: the interpolation's inputs as SampleBlock's, then the stored
-  // triangle's plane as the refinement reads it (RefinePlaneLanes).
-  alignas(64) double x0[kBlock], y0[kBlock];
-  alignas(64) double iw0[kBlock], iwx[kBlock], iwy[kBlock];
-  alignas(64) double dw0[kBlock], dwx[kBlock], dwy[kBlock];
-  alignas(64) double b10[kBlock], b1x[kBlock], b1y[kBlock];
-  alignas(64) double b20[kBlock], b2x[kBlock], b2y[kBlock];
-  alignas(64) double e1x[kBlock], e1y[kBlock], e1z[kBlock], e2x[kBlock], e2y[kBlock], e2z[kBlock];
-  alignas(64) double sx[kBlock], sy[kBlock], sz[kBlock], qx[kBlock], qy[kBlock], qz[kBlock];
-  alignas(64) double e2DotQ[kBlock], slot1[kBlock], slot2[kBlock];
-  // Out, per lane: interpolated depth and barycentrics, the ray's
-  // direction, the refined barycentrics and 1 where they replace the
-  // interpolated ones.
-  alignas(64) double depth[kBlock], b1[kBlock], b2[kBlock];
-  alignas(64) double dirX[kBlock], dirY[kBlock], dirZ[kBlock];
-  alignas(64) double rb1[kBlock], rb2[kBlock], refined[kBlock];
-};
-
-}  // namespace primary_detail
-}  // namespace rastray
-#endif
-
 HWY_BEFORE_NAMESPACE();
 namespace rastray {
 namespace HWY_NAMESPACE {
@@ -63,9 +25,9 @@ size_t SampleLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 // Per lane: TriangleSetup::viewDepthAt and baryAt (PlaneCoefficients::at:
 // (v0 + dx·(x − x0)) + dy·(y − y0)), then PrimaryRays::operator() for a
-// perspective camera (ndcFromImage, the view-plane vector and its glm
-// length ((x² + y²) + 1, the z² of −1 being exactly 1), worldFromView's
-// columns, glm::normalize (v · (1 / √(v·v))) and 1 / length), then the
+// perspective camera (ndcFromImage, the view-plane vector, worldFromView's
+// columns, glm::normalize (v · (1 / √(v·v))); the ray's depthPerT is not
+// needed, see below), then the
 // refinement on the stored triangle's plane (RefineOnPlane) with that ray,
 // in registers: the same operations as primarySamplesReference followed by
 // refinePrimaryHits.
@@ -92,10 +54,16 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     hn::Store(hn::Mul(plane(b->b10, b->b1x, b->b1y), inv), d, b->b1 + i);
     hn::Store(hn::Mul(plane(b->b20, b->b2x, b->b2y), inv), d, b->b2 + i);
 
-    const auto ndcX = hn::Sub(hn::Div(hn::Mul(two, x), width), one);
-    const auto ndcY = hn::Sub(one, hn::Div(hn::Mul(two, y), height));
-    const auto vx = hn::Mul(ndcX, sx), vy = hn::Mul(ndcY, sy);
-    const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), one));
+    hn::Vec<decltype(d)> vx, vy;
+    if (b->haveView) {
+      vx = hn::Load(d, b->vx + i);
+      vy = hn::Load(d, b->vy + i);
+    } else {
+      const auto ndcX = hn::Sub(hn::Div(hn::Mul(two, x), width), one);
+      const auto ndcY = hn::Sub(one, hn::Div(hn::Mul(two, y), height));
+      vx = hn::Mul(ndcX, sx);
+      vy = hn::Mul(ndcY, sy);
+    }
     const auto wx = hn::Add(hn::Add(hn::Mul(m0x, vx), hn::Mul(m1x, vy)), cx);
     const auto wy = hn::Add(hn::Add(hn::Mul(m0y, vx), hn::Mul(m1y, vy)), cy);
     const auto wz = hn::Add(hn::Add(hn::Mul(m0z, vx), hn::Mul(m1z, vy)), cz);
@@ -114,7 +82,13 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     pl.e2DotQ = get(b->e2DotQ);
     pl.slot1 = get(b->slot1), pl.slot2 = get(b->slot2);
     hn::Vec<decltype(d)> rb1, rb2;
-    const auto ok = RefineOnPlane(d, dirX, dirY, dirZ, hn::Div(one, length), pl, &rb1, &rb2);
+    // depthPerT = 1 / length, with length = √((vx² + vy²) + 1) ≥ 1 (or
+    // +inf, or NaN with NaN directions), only enters RefineOnPlane's test
+    // that t · depthPerT is finite: with depthPerT in [0, 1] that holds
+    // exactly when t is finite, which it also tests. So 1 gives the same
+    // mask without a square root and a division per lane (tested against
+    // refinePrimaryHit, which uses the ray's own depthPerT).
+    const auto ok = RefineOnPlane(d, dirX, dirY, dirZ, one, pl, &rb1, &rb2);
     hn::Store(rb1, d, b->rb1 + i);
     hn::Store(rb2, d, b->rb2 + i);
     hn::Store(hn::IfThenElseZero(ok, one), d, b->refined + i);
@@ -161,85 +135,205 @@ void primarySamplesReference(const PrimaryRayConstants& camera, const TriangleSe
   }
 }
 
+PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups)
+    : camera_(camera),
+      scene_(scene),
+      setups_(setups),
+      // Not value-initialised (about 30 KB a tile): every lane and run
+      // entry is written before it is read.
+      block_(new primary_detail::FusedBlock),
+      planes_(new Plane[size_t(1) << kPlaneCacheBits]),
+      planeKeys_(new uint64_t[size_t(1) << kPlaneCacheBits]) {
+  std::fill_n(planeKeys_.get(), size_t(1) << kPlaneCacheBits, kNoPlane);
+  block_->haveView = true;  // until add() says otherwise
+}
+
+PrimaryBatch::~PrimaryBatch() = default;
+
+size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int spp, int x0, int y,
+                            const glm::dvec2* grid, uint32_t local0, uint32_t* localOut) {
+  // The view-plane vector of every sample of the row, as the lanes would
+  // compute it (ndcFromImage, then · scale): per column and sample once
+  // per tile, per sample once per row.
+  const size_t columns = n / size_t(spp) + 1;
+  if (columnX0_ != x0 || columnSpp_ != spp || columnView_.size() < columns * size_t(spp)) {
+    columnX0_ = x0;
+    columnSpp_ = spp;
+    columnView_.resize(columns * size_t(spp));
+    for (size_t c = 0; c < columns; ++c)
+      for (int s = 0; s < spp; ++s) {
+        const double x = double(x0 + int(c)) + grid[s].x;
+        columnView_[c * size_t(spp) + size_t(s)] = ((2.0 * x) / camera_.width - 1.0) * camera_.scale.x;
+      }
+  }
+  if (rowY_ != y || rowSpp_ != spp || rowView_.empty()) {
+    rowY_ = y;
+    rowSpp_ = spp;
+    rowView_.resize(size_t(spp));
+    for (int s = 0; s < spp; ++s) {
+      const double yy = double(y) + grid[s].y;
+      rowView_[size_t(s)] = (1.0 - (2.0 * yy) / camera_.height) * camera_.scale.y;
+    }
+  }
+  const double* const columnView = columnView_.data();
+  const double* const rowView = rowView_.data();
+  // The batch's state in locals (registers) for the loop.
+  primary_detail::FusedBlock& b = *block_;
+  size_t used = used_, runs = runs_;
+  uint32_t last = lastWinner_;
+  const double py = double(y);
+  size_t i = first;
+  int s = int(first % size_t(spp));
+  double px = double(x0 + int(first / size_t(spp)));
+  for (; i < n && used < primary_detail::kBlock; ++i) {
+    const uint32_t win = winners[i];
+    if (win != kNoSetup) {
+      if (win != last || runs == 0) {
+        fillRun(runs++, win);
+        last = win;
+      }
+      // corner + grid position, as glm adds them
+      b.x[used] = px + grid[s].x;
+      b.y[used] = py + grid[s].y;
+      b.run[used] = int64_t(runs - 1);
+      b.vx[used] = columnView[i];
+      b.vy[used] = rowView[s];
+      localOut[used] = local0 + uint32_t(i);
+      ++used;
+    }
+    if (++s == spp) {
+      s = 0;
+      px += 1.0;
+    }
+  }
+  used_ = used;
+  runs_ = runs;
+  lastWinner_ = last;
+  return i;
+}
+
+// Run r: its setup's planes and its stored triangle's plane.
+void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
+  primary_detail::FusedBlock& b = *block_;
+  const TriangleSetup& t = setups_[winner];
+  runSetup_[r] = &t;
+  b.x0[r] = t.depth.x0, b.y0[r] = t.depth.y0;
+  b.iw0[r] = t.invW.v0, b.iwx[r] = t.invW.dx, b.iwy[r] = t.invW.dy;
+  b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
+  b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
+  b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
+  const size_t slot = (t.triangle * 2654435761u + t.instance * 40503u) >> (32 - kPlaneCacheBits);
+  Plane& p = planes_[slot];
+  const uint64_t key = t.id();
+  if (planeKeys_[slot] != key) {
+    planeKeys_[slot] = key;
+    // glm: the same bits as intersectTrianglePlane's memo.
+    const TrianglePlane plane = trianglePlane(scene_, t.instance, t.triangle);
+    p.e1 = plane.e1;
+    p.e2 = plane.e2;
+    p.s = camera_.eye - plane.a;
+    p.q = glm::cross(p.s, plane.e1);
+    p.e2DotQ = glm::dot(plane.e2, p.q);
+    p.slot1 = double(plane.slot1);
+    p.slot2 = double(plane.slot2);
+  }
+  b.e1x[r] = p.e1.x, b.e1y[r] = p.e1.y, b.e1z[r] = p.e1.z;
+  b.e2x[r] = p.e2.x, b.e2y[r] = p.e2.y, b.e2z[r] = p.e2.z;
+  b.sx[r] = p.s.x, b.sy[r] = p.s.y, b.sz[r] = p.s.z;
+  b.qx[r] = p.q.x, b.qy[r] = p.q.y, b.qz[r] = p.q.z;
+  b.e2DotQ[r] = p.e2DotQ;
+  b.slot1[r] = p.slot1;
+  b.slot2[r] = p.slot2;
+  runInstance_[r] = t.instance;
+  runTriangle_[r] = t.triangle;
+}
+
+void PrimaryBatch::run() {
+  primary_detail::FusedBlock& b = *block_;
+  if (used_ == 0) return;
+  if (camera_.perspective) {
+    // Padding: the last run again, at the image origin; never read back.
+    const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(SampleLanes)();
+    b.lanes = (used_ + vectorLanes - 1) / vectorLanes * vectorLanes;
+    for (size_t k = used_; k < b.lanes; ++k) {
+      b.x[k] = b.y[k] = 0.0;
+      b.run[k] = int64_t(runs_ - 1);
+    }
+    HWY_DYNAMIC_DISPATCH(LanesFusedPrimary)(&b, &camera_);
+    for (size_t k = 0; k < used_; ++k) {
+      const bool refined = b.refined[k] != 0.0;
+      kb1_[k] = float(refined ? b.rb1[k] : b.b1[k]);
+      kb2_[k] = float(refined ? b.rb2[k] : b.b2[k]);
+      run32_[k] = int32_t(b.run[k]);
+    }
+    return;
+  }
+  // Orthographic rays: the reference steps, then the batched refinement.
+  const PrimaryRays primary(*camera_.camera);
+  SampleHit hits[primary_detail::kBlock];
+  Ray rays[primary_detail::kBlock];
+  ShadeHit refined[primary_detail::kBlock];
+  const glm::dvec2 unused[primary_detail::kBlock] = {};
+  for (size_t k = 0; k < used_; ++k) {
+    const glm::dvec2 pos(b.x[k], b.y[k]);
+    hits[k] = interpolatedSampleHit(*runSetup_[b.run[k]], pos);
+    rays[k] = primary(pos);
+  }
+  refinePrimaryHits(scene_, rays, hits, unused, used_, refined);
+  for (size_t k = 0; k < used_; ++k) {
+    // Exact in double: hit(k) rounds them back to the same floats.
+    b.depth[k] = double(hits[k].depth);
+    b.b1[k] = double(hits[k].b1);
+    b.b2[k] = double(hits[k].b2);
+    b.dirX[k] = refined[k].direction.x;
+    b.dirY[k] = refined[k].direction.y;
+    b.dirZ[k] = refined[k].direction.z;
+    kb1_[k] = refined[k].b1;
+    kb2_[k] = refined[k].b2;
+    run32_[k] = int32_t(b.run[k]);
+  }
+}
+
+PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footprintY,
+                                   const uint32_t* colorIndex) const {
+  PrimaryHitBlock h;
+  h.count = used_;
+  h.run = run32_;
+  h.runInstance = runInstance_;
+  h.runTriangle = runTriangle_;
+  h.dirX = block_->dirX;
+  h.dirY = block_->dirY;
+  h.dirZ = block_->dirZ;
+  h.b1 = kb1_;
+  h.b2 = kb2_;
+  h.footprintX = footprintX;
+  h.footprintY = footprintY;
+  h.colorIndex = colorIndex;
+  return h;
+}
+
 void primaryShadeHits(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
                       const uint32_t* winners, const glm::dvec2* positions, const glm::dvec2* footprints,
                       size_t count, SampleHit* hits, ShadeHit* out) {
-  if (!camera.perspective) {
-    // Orthographic rays: the reference, then the batched refinement.
-    thread_local std::vector<Ray> rays;
-    rays.resize(count);
-    primarySamplesReference(camera, setups, winners, positions, count, hits, rays.data());
-    refinePrimaryHits(scene, rays.data(), hits, footprints, count, out);
-    return;
-  }
-  using primary_detail::kBlock;
-  thread_local primary_detail::FusedBlock b;
-  const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(SampleLanes)();
-  // The current stored triangle's plane, with the eye-dependent terms as
-  // intersectTrianglePlane's memo computes them (glm: the same bits).
-  uint32_t planeInstance = kNoId, planeTriangle = kNoId;
-  TrianglePlane plane{};
-  glm::dvec3 s(0.0), q(0.0);
-  double e2DotQ = 0.0;
-  const TriangleSetup* runSetup[kBlock];
-  for (size_t first = 0; first < count; first += kBlock) {
-    const size_t used = std::min(kBlock, count - first);
-    int64_t runs = 0;
-    uint32_t lastWinner = 0;  // a run starts at k = 0 whatever it holds
+  const std::unique_ptr<PrimaryBatch> batch = std::make_unique<PrimaryBatch>(camera, scene, setups);
+  for (size_t first = 0; first < count; first += primary_detail::kBlock) {
+    const size_t used = std::min(primary_detail::kBlock, count - first);
+    for (size_t k = 0; k < used; ++k)
+      batch->add(winners[first + k], positions[first + k].x, positions[first + k].y);
+    batch->run();
+    const PrimaryHitBlock h = batch->hits(nullptr, nullptr, nullptr);
     for (size_t k = 0; k < used; ++k) {
-      const uint32_t win = winners[first + k];
-      const glm::dvec2& p = positions[first + k];
-      b.x[k] = p.x, b.y[k] = p.y;
-      if (win != lastWinner || runs == 0) {
-        // A new run: its setup's planes and its stored triangle's plane.
-        lastWinner = win;
-        const int64_t r = runs++;
-        const TriangleSetup& t = setups[win];
-        runSetup[r] = &t;
-        b.x0[r] = t.depth.x0, b.y0[r] = t.depth.y0;
-        b.iw0[r] = t.invW.v0, b.iwx[r] = t.invW.dx, b.iwy[r] = t.invW.dy;
-        b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
-        b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
-        b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
-        if (t.instance != planeInstance || t.triangle != planeTriangle) {
-          plane = trianglePlane(scene, t.instance, t.triangle);
-          s = camera.eye - plane.a;
-          q = glm::cross(s, plane.e1);
-          e2DotQ = glm::dot(plane.e2, q);
-          planeInstance = t.instance;
-          planeTriangle = t.triangle;
-        }
-        b.e1x[r] = plane.e1.x, b.e1y[r] = plane.e1.y, b.e1z[r] = plane.e1.z;
-        b.e2x[r] = plane.e2.x, b.e2y[r] = plane.e2.y, b.e2z[r] = plane.e2.z;
-        b.sx[r] = s.x, b.sy[r] = s.y, b.sz[r] = s.z;
-        b.qx[r] = q.x, b.qy[r] = q.y, b.qz[r] = q.z;
-        b.e2DotQ[r] = e2DotQ;
-        b.slot1[r] = double(plane.slot1);
-        b.slot2[r] = double(plane.slot2);
-      }
-      b.run[k] = runs - 1;
-    }
-    // Padding: the last run again, at the image origin; never read back.
-    b.lanes = (used + vectorLanes - 1) / vectorLanes * vectorLanes;
-    for (size_t k = used; k < b.lanes; ++k) {
-      b.x[k] = b.y[k] = 0.0;
-      b.run[k] = runs - 1;
-    }
-    HWY_DYNAMIC_DISPATCH(LanesFusedPrimary)(&b, &camera);
-    for (size_t k = 0; k < used; ++k) {
-      const TriangleSetup& t = *runSetup[b.run[k]];
-      const SampleHit h{t.instance, t.triangle, float(b.depth[k]), float(b.b1[k]), float(b.b2[k])};
-      hits[first + k] = h;
+      hits[first + k] = batch->hit(k);
       ShadeHit& r = out[first + k];
-      r.instance = h.instance;
-      r.triangle = h.triangle;
-      const bool refined = b.refined[k] != 0.0;
-      r.b1 = refined ? float(b.rb1[k]) : h.b1;
-      r.b2 = refined ? float(b.rb2[k]) : h.b2;
-      r.direction = glm::dvec3(b.dirX[k], b.dirY[k], b.dirZ[k]);
+      r.instance = h.runInstance[h.run[k]];
+      r.triangle = h.runTriangle[h.run[k]];
+      r.b1 = h.b1[k];
+      r.b2 = h.b2[k];
+      r.direction = glm::dvec3(h.dirX[k], h.dirY[k], h.dirZ[k]);
       r.footprintPosition = footprints[first + k];
       r.throughput = 1.0f;
     }
+    batch->clear();
   }
 }
 

@@ -12,6 +12,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -19,6 +21,7 @@
 #include "common/hit.h"
 #include "common/scene.h"
 #include "common/shading_kernel.h"
+#include "raster/coverage.h"
 #include "raster/setup.h"
 
 namespace rastray {
@@ -53,6 +56,137 @@ void primarySamplesReference(const PrimaryRayConstants& camera, const TriangleSe
 void primaryShadeHits(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
                       const uint32_t* winners, const glm::dvec2* positions, const glm::dvec2* footprints,
                       size_t count, SampleHit* hits, ShadeHit* out);
+
+namespace primary_detail {
+
+constexpr size_t kBlock = kPrimaryHitBlock;  // a multiple of every target's double lane count (2, 4, 8)
+
+// The fused pass's block (PrimaryBatch). Consecutive samples mostly lie on
+// one setup, so what is constant along a run of them (the setup's planes,
+// the stored triangle's plane) is stored once per run in a table, and each
+// lane holds only its position and its run: a vector of lanes on one run
+// reads the table as broadcasts, a vector across runs gathers.
+struct FusedBlock {
+  size_t lanes = 0;
+  alignas(64) double x[kBlock], y[kBlock];
+  alignas(64) int64_t run[kBlock];  // non-decreasing within the block
+  // The view-plane vector (ndc · scale) per lane, when every lane has it
+  // (`haveView`: added by addRow from per-tile tables, the operations of
+  // the lanes); else the lanes compute it from x and y.
+  bool haveView = false;
+  alignas(64) double vx[kBlock], vy[kBlock];
+  // Per run: the interpolation's inputs, then the stored triangle's plane
+  // as the refinement reads it (RefinePlaneLanes).
+  alignas(64) double x0[kBlock], y0[kBlock];
+  alignas(64) double iw0[kBlock], iwx[kBlock], iwy[kBlock];
+  alignas(64) double dw0[kBlock], dwx[kBlock], dwy[kBlock];
+  alignas(64) double b10[kBlock], b1x[kBlock], b1y[kBlock];
+  alignas(64) double b20[kBlock], b2x[kBlock], b2y[kBlock];
+  alignas(64) double e1x[kBlock], e1y[kBlock], e1z[kBlock], e2x[kBlock], e2y[kBlock], e2z[kBlock];
+  alignas(64) double sx[kBlock], sy[kBlock], sz[kBlock], qx[kBlock], qy[kBlock], qz[kBlock];
+  alignas(64) double e2DotQ[kBlock], slot1[kBlock], slot2[kBlock];
+  // Out, per lane: interpolated depth and barycentrics, the ray's
+  // direction, the refined barycentrics and 1 where they replace the
+  // interpolated ones.
+  alignas(64) double depth[kBlock], b1[kBlock], b2[kBlock];
+  alignas(64) double dirX[kBlock], dirY[kBlock], dirZ[kBlock];
+  alignas(64) double rb1[kBlock], rb2[kBlock], refined[kBlock];
+};
+
+}  // namespace primary_detail
+
+// The fused pass a block of up to kPrimaryHitBlock samples at a time, the
+// block filled by the caller sample by sample (the winner loop: no
+// per-sample request arrays), its results handed to the shading kernel as
+// struct of arrays (PrimaryHitBlock: no ShadeHit per sample). The same
+// bits as primaryShadeHits, which runs through it.
+class PrimaryBatch {
+ public:
+  PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups);
+  ~PrimaryBatch();
+  PrimaryBatch(const PrimaryBatch&) = delete;
+  PrimaryBatch& operator=(const PrimaryBatch&) = delete;
+
+  size_t size() const { return used_; }
+  // The added samples' image positions, in the order added.
+  const double* x() const { return block_->x; }
+  const double* y() const { return block_->y; }
+  bool full() const { return used_ == primary_detail::kBlock; }
+
+  // Adds the sample at image position (x, y), won by setups[winner].
+  void add(uint32_t winner, double x, double y) {
+    block_->haveView = false;
+    const size_t k = used_++;
+    block_->x[k] = x;
+    block_->y[k] = y;
+    if (winner != lastWinner_ || runs_ == 0) {
+      fillRun(runs_++, winner);
+      lastWinner_ = winner;
+    }
+    block_->run[k] = int64_t(runs_ - 1);
+  }
+
+  // Adds the winners of samples [first, n) of one tile row: entry i is
+  // sample i % spp of pixel x0 + i / spp in row y, at (x0 + i / spp, y) +
+  // grid[i % spp], tile sample local0 + i, whose index goes to
+  // localOut[k] for the batch's sample k; kNoSetup entries are skipped.
+  // Stops when the block is full; returns where it stopped.
+  size_t addRow(const uint32_t* winners, size_t first, size_t n, int spp, int x0, int y,
+                const glm::dvec2* grid, uint32_t local0, uint32_t* localOut);
+
+  // Runs the added samples through the lanes (perspective) or the scalar
+  // reference steps (orthographic); then hit(k) and hits() hold their
+  // results until clear().
+  void run();
+  // The interpolated hit of sample k (primaryShadeHits' `hits`).
+  SampleHit hit(size_t k) const {
+    const int64_t r = block_->run[k];
+    return {runInstance_[r], runTriangle_[r], float(block_->depth[k]), float(block_->b1[k]),
+            float(block_->b2[k])};
+  }
+  // The refined hits for the kernel; footprints and colour indices are the
+  // caller's (per sample, in the order added).
+  PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex) const;
+  void clear() {
+    used_ = 0;
+    runs_ = 0;
+    block_->haveView = true;
+  }
+
+ private:
+  void fillRun(size_t r, uint32_t winner);  // run r's table entry
+
+  const PrimaryRayConstants& camera_;
+  const Scene& scene_;
+  const TriangleSetup* setups_;
+  std::unique_ptr<primary_detail::FusedBlock> block_;
+  size_t used_ = 0, runs_ = 0;
+  uint32_t lastWinner_ = 0;
+  const TriangleSetup* runSetup_[primary_detail::kBlock];
+  // Per run and per sample, for the kernel (after run()).
+  uint32_t runInstance_[primary_detail::kBlock], runTriangle_[primary_detail::kBlock];
+  alignas(64) int32_t run32_[primary_detail::kBlock];
+  alignas(64) float kb1_[primary_detail::kBlock], kb2_[primary_detail::kBlock];
+  // The stored triangle's plane as a run needs it (with the eye-dependent
+  // terms as intersectTrianglePlane's memo computes them), for recent
+  // triangles: a function of the triangle and the eye alone, cached by
+  // triangle. Small triangles give runs of one or two samples, and a
+  // tile's next row meets the same triangles again.
+  struct Plane {
+    glm::dvec3 e1, e2, s, q;
+    double e2DotQ, slot1, slot2;
+  };
+  static constexpr int kPlaneCacheBits = 7;
+  std::unique_ptr<Plane[]> planes_;        // uninitialised where planeKeys_ holds kNoPlane
+  std::unique_ptr<uint64_t[]> planeKeys_;  // (instance << 32 | triangle) of each entry
+  static constexpr uint64_t kNoPlane = ~uint64_t(0);
+  // addRow's view-plane vectors: per column of the last x0 and sample
+  // (vx), per sample of the last row (vy).
+  std::vector<double> columnView_;
+  int columnX0_ = 0, columnSpp_ = 0;
+  std::vector<double> rowView_;
+  int rowY_ = 0, rowSpp_ = 0;
+};
 
 // TileRenderer::interpolatedHit: depth and barycentrics at `pos` from the
 // setup's planes, rounded to float.

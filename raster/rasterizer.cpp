@@ -105,8 +105,13 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   // Setups that cover no sample change no sample; the wireframe still
   // draws their edges, and a pixel trace reports their coverage tests.
   filter.keepSampleless = options.wireframe || options.trace.sink != nullptr;
-  const std::vector<TriangleSetup> setups =
-      prepareTriangles(scene, space, grid, depth, options.cull, filter, &sc);
+  // Buffers kept between frames (raster/frame_buffers.h), when the caller
+  // has a pool: the setups' storage now, the image and the wireframe's
+  // depth target below.
+  FrameBufferLease buffers(options.frameBuffers);
+  std::vector<TriangleSetup>& setupStorage = buffers.setups();
+  prepareTriangles(scene, space, grid, depth, options.cull, filter, &sc, SetupPath::Fast, &setupStorage);
+  const std::vector<TriangleSetup>& setups = setupStorage;
   out.timings.emplace_back("raster.setup", secondsSince(start));
 
   // Bin: OPAQUE and MASK apart from BLEND (built only when the scene has BLEND).
@@ -132,7 +137,6 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   // the tiles; otherwise each tile keeps a target of its own rectangle.
   // Reused storage holds the last frame's values: each tile clears its
   // rectangle of the target, and the resolve writes every pixel.
-  FrameBufferLease buffers(options.frameBuffers);
   bool targetCleared = false;
   DepthTarget* target =
       options.wireframe ? &buffers.target(camera.width, camera.height, options.spp, &targetCleared) : nullptr;

@@ -492,6 +492,14 @@ void computeVertexCodes(const Scene& scene, const ClipSpace& space, const Sample
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
                                             const SampleGrid& grid, const DepthSettings& depth, CullMode cull,
                                             TriangleFilter filter, SetupCounters* counters, SetupPath path) {
+  std::vector<TriangleSetup> setups;
+  prepareTriangles(scene, space, grid, depth, cull, filter, counters, path, &setups);
+  return setups;
+}
+
+void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
+                      const DepthSettings& depth, CullMode cull, TriangleFilter filter,
+                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* out) {
   // Chunks of one instance's triangles, set up in parallel and appended in
   // chunk order by a pipeline: deterministic whatever the scheduling, and
   // only the chunks in flight (a few per thread) exist besides the result,
@@ -515,9 +523,14 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
   // One setup per input triangle at most, unless clipping splits some: the
   // capacity is reserved once, and pages the setups never reach are never
   // touched (so they cost address space, not memory).
-  std::vector<TriangleSetup> setups;
-  setups.reserve(inputs);
-  adviseHugePages(setups.data(), setups.capacity() * sizeof(TriangleSetup));
+  std::vector<TriangleSetup>& setups = *out;
+  setups.clear();
+  if (setups.capacity() < inputs) {
+    // Fresh storage (reused storage was advised when it was made).
+    std::vector<TriangleSetup>().swap(setups);
+    setups.reserve(inputs);
+    adviseHugePages(setups.data(), setups.capacity() * sizeof(TriangleSetup));
+  }
   size_t next = 0, appendedInputs = 0;
   const size_t tokens = 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
   // A chunk's output waits in its slot from the parallel stage to the ordered
@@ -569,7 +582,6 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
   edges.fork();
   tbb::parallel_pipeline(tokens, filters);
   edges.join();
-  return setups;
 }
 
 }  // namespace rastray

@@ -198,4 +198,12 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
                                             TriangleFilter filter, SetupCounters* counters,
                                             SetupPath path = SetupPath::Fast);
 
+// The same into `*setups`, whose previous contents are replaced and whose
+// storage is reused when large enough: a caller that sets up frame after
+// frame (raster/frame_buffers.h) does not map, fault in and zero fresh
+// pages for every frame's setups (hundreds of MB at 10^6 triangles).
+void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
+                      const DepthSettings& depth, CullMode cull, TriangleFilter filter,
+                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* setups);
+
 }  // namespace rastray

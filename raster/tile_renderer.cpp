@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "common/sampling.h"
@@ -75,8 +76,13 @@ void makeTileTarget(const TileRect& rect, int spp, DepthTarget* target) {
   target->x0 = rect.x0;
   target->y0 = rect.y0;
   const size_t n = size_t(target->width) * size_t(target->height) * size_t(spp);
-  target->keys.assign(n, kClearDepthKey);
-  target->winners.assign(n, kNoSetup);
+  // Both cleared values are all ones: a memset (vector::assign filled
+  // them one element at a time).
+  static_assert(kClearDepthKey == 0xFFFFFFFFu && kNoSetup == 0xFFFFFFFFu, "all-ones clear values");
+  target->keys.resize(n);
+  target->winners.resize(n);
+  std::memset(target->keys.data(), 0xFF, n * sizeof(uint32_t));
+  std::memset(target->winners.data(), 0xFF, n * sizeof(uint32_t));
 }
 
 }  // namespace

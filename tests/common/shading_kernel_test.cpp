@@ -326,5 +326,94 @@ TEST(ShadingKernel, TracingAndBlendMaterialsTakeTheScalarPath) {
   EXPECT_NEAR(kernel.r, reference.r, kRelativeBound * std::max(1.0f, reference.r));
 }
 
+// PrimaryHitShader (hits as struct of arrays, in runs on one triangle, the
+// rasterizer's entry) gives shadePrimaryHits' bits on the same hits, on
+// every target: blocks of 1 to 64 hits, colours scattered, lanes that read
+// their run's base colour and emission, lanes that need their own (vertex
+// colours, a visibility callback) mixed with them in one block, the eye
+// light, and BLEND lanes on the scalar path.
+TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
+  const TintedVisibility tinted;
+  Scene base = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
+  // Vertex colours on the first instance only, BLEND on the last
+  // instance's material (when it has one of its own).
+  Scene mixed = base;
+  mixed.colors.assign(mixed.positions.size(), glm::vec4(1.0f));
+  for (size_t v = 0; v < mixed.colors.size(); ++v)
+    mixed.colors[v] = glm::vec4(0.2f + 0.1f * float(v % 7), 0.9f - 0.05f * float(v % 5), 0.5f, 1.0f);
+  mixed.instances.front().hasColors = true;
+  Material blend = mixed.materials[mixed.instances.back().material];
+  blend.alphaMode = AlphaMode::Blend;
+  blend.baseColorFactor.a = 0.4f;
+  mixed.materials.push_back(blend);
+  mixed.instances.back().material = uint32_t(mixed.materials.size() - 1);
+  Scene eyeLit = base;
+  eyeLit.lights.clear();
+  struct Case {
+    const char* name;
+    const Scene* scene;
+    const LightVisibility* visibility;
+  };
+  for (const Case& c :
+       {Case{"plain", &base, nullptr}, Case{"visibility", &base, &tinted},
+        Case{"vertex colours and blend", &mixed, nullptr}, Case{"eye light", &eyeLit, nullptr}}) {
+    SCOPED_TRACE(c.name);
+    const Scene& scene = *c.scene;
+    const Camera camera = makeCamera(scene, {}, 64, 48);
+    const std::vector<ShadeHit> hits = primaryHits(scene, camera, 1500);
+    ASSERT_GT(hits.size(), 500u);
+    const Shader shader(scene, analyzeScene(scene), camera, {}, c.visibility, nullptr);
+    std::vector<glm::vec4> expected(hits.size());
+    shadePrimaryHits(shader, hits.data(), hits.size(), expected.data(), ShadingPath::Kernel);
+    // The hits as struct of arrays, their colours to the reversed order.
+    const size_t n = hits.size();
+    std::vector<int32_t> run(n);
+    std::vector<uint32_t> runInstance, runTriangle, colorIndex(n);
+    std::vector<double> dx(n), dy(n), dz(n), fx(n), fy(n);
+    std::vector<float> b1(n), b2(n);
+    for (size_t i = 0; i < n; ++i) {
+      dx[i] = hits[i].direction.x, dy[i] = hits[i].direction.y, dz[i] = hits[i].direction.z;
+      fx[i] = hits[i].footprintPosition.x, fy[i] = hits[i].footprintPosition.y;
+      b1[i] = hits[i].b1, b2[i] = hits[i].b2;
+      colorIndex[i] = uint32_t(n - 1 - i);
+    }
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      SCOPED_TRACE(hwy::TargetName(target));
+      hwy::SetSupportedTargetsForTest(target);
+      for (const size_t blockSize : {size_t(1), size_t(7), size_t(kPrimaryHitBlock)}) {
+        PrimaryHitShader kernel(shader, ShadingPath::Kernel);
+        std::vector<glm::vec4> got(n, glm::vec4(-1.0f));
+        for (size_t first = 0; first < n; first += blockSize) {
+          const size_t count = std::min(blockSize, n - first);
+          // Runs within the block: a new one where the triangle changes.
+          runInstance.clear();
+          runTriangle.clear();
+          for (size_t k = 0; k < count; ++k) {
+            const ShadeHit& h = hits[first + k];
+            if (k == 0 || h.instance != runInstance.back() || h.triangle != runTriangle.back()) {
+              runInstance.push_back(h.instance);
+              runTriangle.push_back(h.triangle);
+            }
+            run[first + k] = int32_t(runInstance.size() - 1);
+          }
+          PrimaryHitBlock block;
+          block.count = count;
+          block.run = &run[first];
+          block.runInstance = runInstance.data();
+          block.runTriangle = runTriangle.data();
+          block.dirX = &dx[first], block.dirY = &dy[first], block.dirZ = &dz[first];
+          block.b1 = &b1[first], block.b2 = &b2[first];
+          block.footprintX = &fx[first], block.footprintY = &fy[first];
+          block.colorIndex = &colorIndex[first];
+          kernel.shade(block, got.data());
+        }
+        for (size_t i = 0; i < n; ++i)
+          ASSERT_TRUE(sameBits(got[colorIndex[i]], expected[i])) << "block " << blockSize << " hit " << i;
+      }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+  }
+}
+
 }  // namespace
 }  // namespace rastray

@@ -233,6 +233,73 @@ TEST(CoverageEquivalence, HierarchicalDepthSkipsOccludedBlocks) {
   EXPECT_GT(slow.counters.samplesTested, 2 * fast.counters.samplesTested);
 }
 
+// rasterDepthPass told that each tile's rect starts cleared (the camera
+// pass: the hierarchical test then skips reading the keys of blocks not
+// yet fully written) writes the same keys and winners and counts the same
+// tests as without, one pass per tile on a fresh target: small triangles
+// over the whole image (each block written by many, each written sample
+// counted) in front of random triangles behind them (culled where the
+// blocks are written), with and without MASK, at 1 and 4 spp.
+TEST(CoverageEquivalence, ClearedRectsGiveTheSameTargetAndCounters) {
+  Scene scene;
+  // A 60 × 60 grid of quads, two triangles each, about 2.5 pixels a
+  // triangle, in front of the random scene's triangles.
+  std::vector<glm::vec3> p;
+  std::vector<glm::uvec3> t;
+  constexpr int kCells = 60;
+  const double cell = double(kSize) / kCells;
+  for (int y = 0; y <= kCells; ++y)
+    for (int x = 0; x <= kCells; ++x)
+      p.push_back(world(x * cell, y * cell, -1.0 - 0.001 * ((x * 7 + y * 3) % 11)));
+  for (int y = 0; y < kCells; ++y)
+    for (int x = 0; x < kCells; ++x) {
+      const uint32_t a = uint32_t(y * (kCells + 1) + x);
+      t.push_back({a, a + 1, a + uint32_t(kCells) + 2});
+      t.push_back({a, a + uint32_t(kCells) + 2, a + uint32_t(kCells) + 1});
+    }
+  test::addMesh(scene, p, t);
+  const Scene behind = randomScene(5, 60);
+  for (const Instance& inst : behind.instances) {
+    std::vector<glm::vec3> q(behind.positions.begin() + inst.firstVertex,
+                             behind.positions.begin() + inst.firstVertex + inst.vertexCount);
+    for (glm::vec3& v : q) v.z = std::min(v.z, -2.0f);
+    std::vector<glm::uvec3> u;
+    for (uint32_t i = 0; i < inst.triangleCount; ++i)
+      u.push_back(behind.triangles[inst.firstTriangle + i] - glm::uvec3(inst.firstVertex));
+    test::addMesh(scene, q, u);
+  }
+  const Camera camera = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
+  for (const int spp : {1, 4}) {
+    const SampleGrid grid = makeSampleGrid(spp, kSize, kSize);
+    const auto setups = setupScene(scene, camera, grid, DepthFormat::FloatReversed);
+    std::vector<uint32_t> bin;
+    for (uint32_t i = 0; i < setups.size(); ++i) bin.push_back(i);
+    for (const bool mask : {false, true}) {
+      SCOPED_TRACE("spp " + std::to_string(spp) + (mask ? ", MASK" : ""));
+      std::function<bool(const TriangleSetup&, int, int, int)> alpha;
+      if (mask)
+        alpha = [](const TriangleSetup& tri, int x, int y, int s) {
+          return ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ uint32_t(s) ^ tri.triangle) % 7 !=
+                 0;
+        };
+      PassResult plain{DepthTarget(kSize, kSize, spp), {}}, cleared{DepthTarget(kSize, kSize, spp), {}};
+      const TileGrid tiles(kSize, kSize);
+      for (int tile = 0; tile < tiles.count(); ++tile) {
+        rasterDepthPass(setups, bin, grid, tiles.rect(tile), DepthFormat::FloatReversed, DepthFunc::Less,
+                        alpha, TraceRequest{}, &plain.target, &plain.counters, CoveragePath::Fast, false);
+        rasterDepthPass(setups, bin, grid, tiles.rect(tile), DepthFormat::FloatReversed, DepthFunc::Less,
+                        alpha, TraceRequest{}, &cleared.target, &cleared.counters, CoveragePath::Fast, true);
+      }
+      EXPECT_EQ(plain.target.keys, cleared.target.keys);
+      EXPECT_EQ(plain.target.winners, cleared.target.winners);
+      EXPECT_EQ(plain.counters.coverageTests, cleared.counters.coverageTests);
+      EXPECT_EQ(plain.counters.samplesTested, cleared.counters.samplesTested);
+      EXPECT_EQ(plain.counters.samplesPassed, cleared.counters.samplesPassed);
+      EXPECT_EQ(plain.counters.alphaRejected, cleared.counters.alphaRejected);
+    }
+  }
+}
+
 TEST(CoverageEquivalence, RendersMatchTheReferenceWalkWithMaskAndBlend) {
   Scene scene = randomScene(21, 120);
   // Every third instance MASK with a constant alpha below the cutoff on

@@ -238,5 +238,124 @@ TEST(PrimarySamples, FusedPassGivesTheTwoStepsBitsOnEveryTarget) {
   }
 }
 
+// PrimaryBatch::addRow, the winner loop's way in (positions from the tile
+// row, view-plane vectors from per-tile tables), gives primaryShadeHits'
+// bits for the same samples: the interpolated hits, and the refined
+// barycentrics, directions and runs it hands the kernel, on every target,
+// at 1 and 4 samples per pixel, with empty samples (kNoSetup) skipped,
+// rows that fill a block part way, and tiles at odd offsets.
+TEST(PrimarySamples, RowsGiveTheSameBitsAsSamplesOnEveryTarget) {
+  std::mt19937 rng(31);
+  struct Case {
+    std::string name;
+    Camera camera;
+    glm::dvec3 centre;
+    double size;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"1920x1080 60deg",
+                   test::perspectiveCamera(1920, 1080, 1.047, {0.3, 0.2, 4.0}, {0, 0, 0}),
+                   {0, 0, 0},
+                   1.5});
+  cases.push_back({"97x61 far eye",
+                   test::perspectiveCamera(97, 61, 0.7, {1e6, -3e5, 2e6}, {1e6 + 1, -3e5, 0}),
+                   {1e6, -3e5, 1e6},
+                   3e5});
+  cases.push_back({"orthographic", test::orthoCamera(128, 3.0), {0, 0, 0}, 2.0});
+  const std::vector<glm::dvec2> grid1 = {{0.5, 0.5}};
+  const std::vector<glm::dvec2> grid4 = {{0.375, 0.125}, {0.875, 0.375}, {0.125, 0.625}, {0.625, 0.875}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const int w = c.camera.width, h = c.camera.height;
+    const Scene scene = trianglesAround(rng, c.centre, c.size);
+    std::vector<TriangleSetup> setups = randomSetups(rng, w, h);
+    for (size_t i = 0; i < setups.size(); ++i) {
+      setups[i].instance = 0;
+      setups[i].triangle = uint32_t(i % scene.triangles.size());
+    }
+    const PrimaryRayConstants constants(c.camera);
+    for (const std::vector<glm::dvec2>* grid : {&grid1, &grid4}) {
+      const int spp = int(grid->size());
+      // Tiles of 37 columns from odd offsets, 9 rows each; per row, runs
+      // on one setup, single samples and empty ones.
+      struct Row {
+        int x0, y;
+        std::vector<uint32_t> winners;
+      };
+      std::vector<Row> rows;
+      for (int t = 0; t < 4; ++t) {
+        const int x0 = (13 + 29 * t) % std::max(1, w - 37), y0 = (7 * t) % std::max(1, h - 9);
+        for (int y = y0; y < y0 + 9 && y < h; ++y) {
+          Row row{x0, y, {}};
+          for (int i = 0; i < 37 * spp; ++i) {
+            const int kind = (i / 11 + y + t) % 4;
+            row.winners.push_back(kind == 0   ? kNoSetup
+                                  : kind == 1 ? uint32_t((i * 7 + y) % setups.size())
+                                              : uint32_t((i / 9 + y * 3) % setups.size()));
+          }
+          rows.push_back(std::move(row));
+        }
+      }
+      // Expected: the same samples through primaryShadeHits, footprint at the sample.
+      std::vector<uint32_t> winners;
+      std::vector<glm::dvec2> positions;
+      std::vector<uint32_t> locals;
+      for (size_t r = 0; r < rows.size(); ++r)
+        for (size_t i = 0; i < rows[r].winners.size(); ++i) {
+          if (rows[r].winners[i] == kNoSetup) continue;
+          winners.push_back(rows[r].winners[i]);
+          positions.push_back(glm::dvec2(rows[r].x0 + int(i) / spp, rows[r].y) + (*grid)[i % size_t(spp)]);
+          locals.push_back(uint32_t(r * 1000 + i));
+        }
+      const size_t n = winners.size();
+      std::vector<SampleHit> expectedHits(n);
+      std::vector<ShadeHit> expected(n);
+      primaryShadeHits(constants, scene, setups.data(), winners.data(), positions.data(), positions.data(), n,
+                       expectedHits.data(), expected.data());
+      for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+        SCOPED_TRACE(hwy::TargetName(target));
+        hwy::SetSupportedTargetsForTest(target);
+        PrimaryBatch batch(constants, scene, setups.data());
+        uint32_t localOut[kPrimaryHitBlock];
+        size_t next = 0;  // the expected sample the batch's first one is
+        const auto check = [&] {
+          batch.run();
+          const PrimaryHitBlock got = batch.hits(batch.x(), batch.y(), localOut);
+          ASSERT_EQ(got.count, batch.size());
+          for (size_t k = 0; k < got.count; ++k, ++next) {
+            ASSERT_LT(next, n);
+            const ShadeHit& e = expected[next];
+            ASSERT_EQ(localOut[k], locals[next]) << "sample " << next;
+            ASSERT_TRUE(sameBits(batch.hit(k), expectedHits[next])) << "sample " << next;
+            const ShadeHit a{got.runInstance[got.run[k]],
+                             got.runTriangle[got.run[k]],
+                             got.b1[k],
+                             got.b2[k],
+                             {got.dirX[k], got.dirY[k], got.dirZ[k]},
+                             {got.footprintX[k], got.footprintY[k]},
+                             1.0f};
+            ASSERT_TRUE(sameBits(a, e)) << "sample " << next;
+            if (k > 0) ASSERT_LE(got.run[k - 1], got.run[k]);
+          }
+          batch.clear();
+        };
+        for (size_t r = 0; r < rows.size(); ++r) {
+          const Row& row = rows[r];
+          for (size_t i = 0; i < row.winners.size();) {
+            i = batch.addRow(row.winners.data(), i, row.winners.size(), spp, row.x0, row.y, grid->data(),
+                             uint32_t(r * 1000), localOut);
+            if (batch.full()) check();
+          }
+          // Every few rows a partial block, as a tile's last one.
+          if (r % 5 == 4 && batch.size() > 0) check();
+        }
+        if (batch.size() > 0) check();
+        EXPECT_EQ(next, n);
+      }
+      hwy::SetSupportedTargetsForTest(0);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rastray
