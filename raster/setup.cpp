@@ -499,7 +499,7 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
 
 void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
                       const DepthSettings& depth, CullMode cull, TriangleFilter filter,
-                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* out) {
+                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* storage) {
   // Chunks of one instance's triangles, set up in parallel and appended in
   // chunk order by a pipeline: deterministic whatever the scheduling, and
   // only the chunks in flight (a few per thread) exist besides the result,
@@ -523,7 +523,7 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
   // One setup per input triangle at most, unless clipping splits some: the
   // capacity is reserved once, and pages the setups never reach are never
   // touched (so they cost address space, not memory).
-  std::vector<TriangleSetup>& setups = *out;
+  std::vector<TriangleSetup>& setups = *storage;
   setups.clear();
   if (setups.capacity() < inputs) {
     // Fresh storage (reused storage was advised when it was made).

@@ -63,7 +63,9 @@ void runCase(const std::string& name, const std::function<void(const Row&)>& bou
 // Hybrid shades with the ray caster's inputs where hits agree: its colour
 // there is the ray caster's to 1e-5 (crossval's --max-hybrid-error).
 void expectHybridColour(const Row& r) {
-  if (isVariant(r, "hybrid vs raytrace")) EXPECT_LE(r.metric, 1e-5) << where(r);
+  if (isVariant(r, "hybrid vs raytrace")) {
+    EXPECT_LE(r.metric, 1e-5) << where(r);
+  }
 }
 
 TEST(StabilityGeometry, SubpixelTrianglesAgreeWithTheRayCaster) {
@@ -93,7 +95,9 @@ TEST(StabilityGeometry, GrazingTexturedPlaneHasFiniteFootprints) {
   runCase("grazing-textured-89.9", [](const Row& r) {
     expectNoGenuine(r);
     expectHybridColour(r);
-    if (isVariant(r, "raster vs raytrace")) EXPECT_EQ(measure(r, "non-finite texture LODs"), 0.0) << where(r);
+    if (isVariant(r, "raster vs raytrace")) {
+      EXPECT_EQ(measure(r, "non-finite texture LODs"), 0.0) << where(r);
+    }
   });
 }
 

@@ -335,7 +335,9 @@ TEST(PrimarySamples, RowsGiveTheSameBitsAsSamplesOnEveryTarget) {
                              {got.footprintX[k], got.footprintY[k]},
                              1.0f};
             ASSERT_TRUE(sameBits(a, e)) << "sample " << next;
-            if (k > 0) ASSERT_LE(got.run[k - 1], got.run[k]);
+            if (k > 0) {
+              ASSERT_LE(got.run[k - 1], got.run[k]);
+            }
           }
           batch.clear();
         };
