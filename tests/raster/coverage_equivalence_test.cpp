@@ -211,15 +211,7 @@ TEST(CoverageEquivalence, HierarchicalDepthSkipsOccludedBlocks) {
                  world(-1, kSize + 1, -1)},
                 {{0, 1, 2}, {0, 2, 3}});
   const Scene behind = randomScene(3, 100);
-  for (const Instance& inst : behind.instances) {
-    std::vector<glm::vec3> p(behind.positions.begin() + inst.firstVertex,
-                             behind.positions.begin() + inst.firstVertex + inst.vertexCount);
-    for (glm::vec3& v : p) v.z = std::min(v.z, -2.0f);
-    std::vector<glm::uvec3> t;
-    for (uint32_t i = 0; i < inst.triangleCount; ++i)
-      t.push_back(behind.triangles[inst.firstTriangle + i] - glm::uvec3(inst.firstVertex));
-    test::addMesh(scene, p, t);
-  }
+  test::addPushedBehind(scene, behind, -2.0f);
   const Camera camera = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
   const SampleGrid grid = makeSampleGrid(4, kSize, kSize);
   const auto setups = setupScene(scene, camera, grid, DepthFormat::FloatReversed);
@@ -259,15 +251,7 @@ TEST(CoverageEquivalence, ClearedRectsGiveTheSameTargetAndCounters) {
     }
   test::addMesh(scene, p, t);
   const Scene behind = randomScene(5, 60);
-  for (const Instance& inst : behind.instances) {
-    std::vector<glm::vec3> q(behind.positions.begin() + inst.firstVertex,
-                             behind.positions.begin() + inst.firstVertex + inst.vertexCount);
-    for (glm::vec3& v : q) v.z = std::min(v.z, -2.0f);
-    std::vector<glm::uvec3> u;
-    for (uint32_t i = 0; i < inst.triangleCount; ++i)
-      u.push_back(behind.triangles[inst.firstTriangle + i] - glm::uvec3(inst.firstVertex));
-    test::addMesh(scene, q, u);
-  }
+  test::addPushedBehind(scene, behind, -2.0f);
   const Camera camera = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
   for (const int spp : {1, 4}) {
     const SampleGrid grid = makeSampleGrid(spp, kSize, kSize);

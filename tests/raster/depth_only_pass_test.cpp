@@ -292,15 +292,7 @@ TEST(DepthOnlyPass, HierarchicalTestSkipsHiddenBlocks) {
                  world(size, -1, size + 1, -1)},
                 {{0, 1, 2}, {0, 2, 3}});
   const Scene behind = randomScene(9, 100, size);
-  for (const Instance& inst : behind.instances) {
-    std::vector<glm::vec3> p(behind.positions.begin() + inst.firstVertex,
-                             behind.positions.begin() + inst.firstVertex + inst.vertexCount);
-    for (glm::vec3& v : p) v.z = std::min(v.z, -2.0f);
-    std::vector<glm::uvec3> t;
-    for (uint32_t i = 0; i < inst.triangleCount; ++i)
-      t.push_back(behind.triangles[inst.firstTriangle + i] - glm::uvec3(inst.firstVertex));
-    test::addMesh(scene, p, t);
-  }
+  test::addPushedBehind(scene, behind, -2.0f);
   const Camera camera = test::orthoCamera(size, size / 2.0, 0.0, 10.0);
   const SampleGrid grid = makeSampleGrid(1, size, size);
   const auto setups = setupFor(scene, camera, grid, DepthFormat::FloatReversed, 0, 0, {});

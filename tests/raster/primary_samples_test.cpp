@@ -157,32 +157,39 @@ TEST(PrimarySamples, LanesGiveTheReferenceBitsOnEveryTarget) {
   }
 }
 
+// Cameras for the fused-pass tests, each with where its random triangles
+// lie (centre, extent): an ordinary view, an eye 1e6 from the origin, a
+// 2.9 rad field of view with triangles around the eye, orthographic.
+struct CameraCase {
+  std::string name;
+  Camera camera;
+  glm::dvec3 centre;
+  double size;
+};
+
+std::vector<CameraCase> cameraCases() {
+  return {{"1920x1080 60deg",
+           test::perspectiveCamera(1920, 1080, 1.047, {0.3, 0.2, 4.0}, {0, 0, 0}),
+           {0, 0, 0},
+           1.5},
+          {"97x61 far eye",
+           test::perspectiveCamera(97, 61, 0.7, {1e6, -3e5, 2e6}, {1e6 + 1, -3e5, 0}),
+           {1e6, -3e5, 1e6},
+           3e5},
+          {"333x777 wide, triangles around the eye",
+           test::perspectiveCamera(333, 777, 2.9, {-2, 1, 1}, {3, 2, -7}),
+           {-2, 1, 1},
+           2.0},
+          {"orthographic", test::orthoCamera(128, 3.0), {0, 0, 0}, 2.0}};
+}
+
 // primaryShadeHits, the rasterizer's fused pass (interpolation, primary ray
 // and refinement in one pass of lanes per block), against the two steps it
 // replaces: primarySamplesReference, then refinePrimaryHit on each ray.
 TEST(PrimarySamples, FusedPassGivesTheTwoStepsBitsOnEveryTarget) {
   std::mt19937 rng(9);
-  struct Case {
-    std::string name;
-    Camera camera;
-    glm::dvec3 centre;
-    double size;
-  };
-  std::vector<Case> cases;
-  cases.push_back({"1920x1080 60deg",
-                   test::perspectiveCamera(1920, 1080, 1.047, {0.3, 0.2, 4.0}, {0, 0, 0}),
-                   {0, 0, 0},
-                   1.5});
-  cases.push_back({"97x61 far eye",
-                   test::perspectiveCamera(97, 61, 0.7, {1e6, -3e5, 2e6}, {1e6 + 1, -3e5, 0}),
-                   {1e6, -3e5, 1e6},
-                   3e5});
-  cases.push_back({"333x777 wide, triangles around the eye",
-                   test::perspectiveCamera(333, 777, 2.9, {-2, 1, 1}, {3, 2, -7}),
-                   {-2, 1, 1},
-                   2.0});
-  cases.push_back({"orthographic", test::orthoCamera(128, 3.0), {0, 0, 0}, 2.0});
-  for (const Case& c : cases) {
+  const std::vector<CameraCase> cases = cameraCases();
+  for (const CameraCase& c : cases) {
     SCOPED_TRACE(c.name);
     const int w = c.camera.width, h = c.camera.height;
     const Scene scene = trianglesAround(rng, c.centre, c.size);
@@ -246,25 +253,10 @@ TEST(PrimarySamples, FusedPassGivesTheTwoStepsBitsOnEveryTarget) {
 // rows that fill a block part way, and tiles at odd offsets.
 TEST(PrimarySamples, RowsGiveTheSameBitsAsSamplesOnEveryTarget) {
   std::mt19937 rng(31);
-  struct Case {
-    std::string name;
-    Camera camera;
-    glm::dvec3 centre;
-    double size;
-  };
-  std::vector<Case> cases;
-  cases.push_back({"1920x1080 60deg",
-                   test::perspectiveCamera(1920, 1080, 1.047, {0.3, 0.2, 4.0}, {0, 0, 0}),
-                   {0, 0, 0},
-                   1.5});
-  cases.push_back({"97x61 far eye",
-                   test::perspectiveCamera(97, 61, 0.7, {1e6, -3e5, 2e6}, {1e6 + 1, -3e5, 0}),
-                   {1e6, -3e5, 1e6},
-                   3e5});
-  cases.push_back({"orthographic", test::orthoCamera(128, 3.0), {0, 0, 0}, 2.0});
+  const std::vector<CameraCase> cases = cameraCases();
   const std::vector<glm::dvec2> grid1 = {{0.5, 0.5}};
   const std::vector<glm::dvec2> grid4 = {{0.375, 0.125}, {0.875, 0.375}, {0.125, 0.625}, {0.625, 0.875}};
-  for (const Case& c : cases) {
+  for (const CameraCase& c : cases) {
     SCOPED_TRACE(c.name);
     const int w = c.camera.width, h = c.camera.height;
     const Scene scene = trianglesAround(rng, c.centre, c.size);

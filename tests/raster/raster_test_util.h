@@ -3,6 +3,7 @@
 
 #include "common/math_constants.h"
 
+#include <algorithm>
 #include <glm/glm.hpp>
 #include <string>
 #include <vector>
@@ -40,6 +41,20 @@ inline uint32_t addMesh(Scene& scene, const std::vector<glm::vec3>& positions,
   }
   scene.instances.push_back(inst);
   return uint32_t(scene.instances.size() - 1);
+}
+
+// Appends each instance of `from` with every vertex moved to z <= zMax
+// (behind an occluder the caller puts in front), keeping its triangles.
+inline void addPushedBehind(Scene& scene, const Scene& from, float zMax) {
+  for (const Instance& inst : from.instances) {
+    std::vector<glm::vec3> p(from.positions.begin() + inst.firstVertex,
+                             from.positions.begin() + inst.firstVertex + inst.vertexCount);
+    for (glm::vec3& v : p) v.z = std::min(v.z, zMax);
+    std::vector<glm::uvec3> t;
+    for (uint32_t i = 0; i < inst.triangleCount; ++i)
+      t.push_back(from.triangles[inst.firstTriangle + i] - glm::uvec3(inst.firstVertex));
+    addMesh(scene, p, t);
+  }
 }
 
 inline Material colored(glm::vec4 c, AlphaMode mode = AlphaMode::Opaque, bool doubleSided = false) {
