@@ -39,22 +39,34 @@ class TemporaryDirectory {
   std::string path_;
 };
 
+}  // namespace
+
 // The last non-empty line POV-Ray wrote to stderr that says what went
-// wrong, for the one-line error.
+// wrong, for the one-line error. POV-Ray warns that it "cannot open the user
+// configuration file" on every run without ~/.povray/3.7/povray.conf, failed
+// or not, so that warning never stands for the failure.
 std::string povrayComplaint(const std::string& err) {
+  auto isUserConfigWarning = [](const std::string& line) {
+    return line.find("user configuration file") != std::string::npos;
+  };
   std::istringstream in(err);
   std::string line, last;
   while (std::getline(in, line)) {
-    if (line.find("rror") != std::string::npos || line.find("annot") != std::string::npos) last = line;
+    if (isUserConfigWarning(line)) continue;
+    if (line.find("rror") != std::string::npos || line.find("annot") != std::string::npos ||
+        line.find("ailed") != std::string::npos)
+      last = line;
   }
   if (last.empty()) {
     std::istringstream again(err);
     while (std::getline(again, line))
-      if (line.find_first_not_of(" \t") != std::string::npos) last = line;
+      if (line.find_first_not_of(" \t") != std::string::npos && !isUserConfigWarning(line)) last = line;
   }
   const size_t start = last.find_first_not_of(" \t");
   return start == std::string::npos ? std::string("no message") : last.substr(start);
 }
+
+namespace {
 
 FlatImage renderWithPovray(const std::string& povray, const std::string& dir, const Camera& camera,
                            bool shadows, double& seconds) {

@@ -21,6 +21,11 @@ namespace rastray {
 // The `povray` program on PATH (an absolute path), or "" when there is none.
 std::string findPovray();
 
+// The line of POV-Ray's stderr `err` that says why it failed, for the one
+// error line: the last error-like line other than its user-configuration
+// warning (printed on every run), else the last non-empty line.
+std::string povrayComplaint(const std::string& err);
+
 struct PovrayCheck {
   Camera camera;
   std::string povSource;  // the SDL POV-Ray rendered

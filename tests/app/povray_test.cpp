@@ -174,6 +174,19 @@ std::string describe(const ShadowMaskAgreement& a) {
   return s.str();
 }
 
+TEST(PovrayCheck, ComplaintNamesTheFailureNotTheUserConfigWarning) {
+  // POV-Ray prints this warning on every run without a user config; when it
+  // once exited 1 beside another POV-Ray run, the error line named only it.
+  const std::string warning =
+      "povray: cannot open the user configuration file /root/.povray/3.7/povray.conf: No such file or "
+      "directory\n";
+  EXPECT_EQ(povrayComplaint(warning + "Parse Error: Expected 'object', } found instead\n"),
+            "Parse Error: Expected 'object', } found instead");
+  EXPECT_EQ(povrayComplaint("Render failed\n" + warning), "Render failed");
+  EXPECT_EQ(povrayComplaint(warning + "  Trace Time: 0 s\n\n"), "Trace Time: 0 s");
+  EXPECT_EQ(povrayComplaint(warning), "no message");
+}
+
 TEST(PovrayCheck, FloorBoxAndFlatSphereUnderADirectionalLightAgreeWithPovray) {
   // Measured at 480x320: the ray caster 0 of 102,428 lit pixels, the
   // rasterizer's maps 24 (0.023 %), along the shadows' edges.
