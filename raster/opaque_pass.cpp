@@ -32,9 +32,16 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   const int spp = grid_.spp;
   // Every sample is written exactly once below (a background sample in the
   // winner loop, a winner's hit and colour after the batch), so the
-  // storage is only sized, never filled first.
+  // storage is only sized, never filled first. The lean form
+  // (raster/resolve.h) has no front hits, only the winners' depths, and at
+  // 1 spp no background colours (the resolve writes them).
+  const bool lean = samples.lean;
+  const bool backgroundColors = !lean || spp > 1;
   samples.color.resize(index.count());
-  samples.front.resize(index.count());
+  if (lean)
+    samples.depth.resize(index.count());
+  else
+    samples.front.resize(index.count());
   // The tile's winning samples a block of kPrimaryHitBlock at a time, in
   // pixel and sample order: the winner loop adds each to the fused pass's
   // block (PrimaryBatch: the interpolated hit, the primary ray and the hit
@@ -66,7 +73,11 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   const auto flush = [&] {
     batch.run();
     const size_t count = batch.size();
-    for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = batch.hit(r);
+    if (lean) {
+      for (size_t r = 0; r < count; ++r) samples.depth[localOut[r]] = batch.depth(r);
+    } else {
+      for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = batch.hit(r);
+    }
     kernel.shade(batch.hits(fpX, fpY, localOut), samples.color.data());
     n.shadedSamples += count;
     batch.clear();
@@ -86,10 +97,15 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     for (int py = rect.y0; py < rect.y1; ++py) {
       const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
       const uint32_t local = index(rect.x0, py, 0);
-      for (size_t i = 0; i < rowSamples; ++i) {
-        if (rowWinners[i] != kNoSetup) continue;
-        samples.color[local + i] = glm::vec4(0.0f);
-        samples.front[local + i] = SampleHit{};
+      if (!lean) {
+        for (size_t i = 0; i < rowSamples; ++i) {
+          if (rowWinners[i] != kNoSetup) continue;
+          samples.color[local + i] = glm::vec4(0.0f);
+          samples.front[local + i] = SampleHit{};
+        }
+      } else if (backgroundColors) {
+        for (size_t i = 0; i < rowSamples; ++i)
+          if (rowWinners[i] == kNoSetup) samples.color[local + i] = glm::vec4(0.0f);
       }
       for (size_t i = 0; i < rowSamples;) {
         i = batch.addRow(rowWinners, i, rowSamples, spp, rect.x0, py, grid_.positions.data(), local,
@@ -111,8 +127,8 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
       for (int s = 0; s < spp; ++s, ++local) {
         const uint32_t win = *rowWinners++;
         if (win == kNoSetup) {
-          samples.color[local] = glm::vec4(0.0f);
-          samples.front[local] = SampleHit{};
+          if (backgroundColors) samples.color[local] = glm::vec4(0.0f);
+          if (!lean) samples.front[local] = SampleHit{};
           continue;
         }
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
@@ -123,7 +139,12 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
           assignments.push_back({local, it->second});
           // The sample's own hit only where someone reads it: the
           // resolve's centre sample, the per-sample hits, the trace.
-          samples.front[local] = allFronts || s == centre_ || traced ? interpolatedHit(t, pos) : SampleHit{};
+          if (lean) {
+            if (s == centre_) samples.depth[local] = interpolatedHit(t, pos).depth;
+          } else {
+            samples.front[local] =
+                allFronts || s == centre_ || traced ? interpolatedHit(t, pos) : SampleHit{};
+          }
         } else {
           // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
           addRequest(win, local, pos, corner + glm::dvec2(0.5));

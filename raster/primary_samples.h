@@ -144,6 +144,8 @@ class PrimaryBatch {
     return {runInstance_[r], runTriangle_[r], float(block_->depth[k]), float(block_->b1[k]),
             float(block_->b2[k])};
   }
+  // hit(k).depth alone.
+  float depth(size_t k) const { return float(block_->depth[k]); }
   // The refined hits for the kernel; footprints and colour indices are the
   // caller's (per sample, in the order added).
   PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex) const;

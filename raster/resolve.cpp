@@ -72,4 +72,49 @@ void resolveTile(const TileRect& rect, int spp, int centreSample, const TileSamp
   streamFence();
 }
 
+void resolveTileLean(const TileRect& rect, int spp, int centreSample, const TileSamples& samples,
+                     const DepthTarget& target, const TriangleSetup* setups, FlatImage* image) {
+  const TileSampleIndex local{rect, spp};
+  glm::vec4 color[kTileSize];
+  float depth[kTileSize];
+  uint32_t instance[kTileSize], triangle[kTileSize];
+  const SampleHit none;
+  // The last winner's ids: consecutive pixels mostly share one.
+  uint32_t last = kNoSetup, lastInstance = none.instance, lastTriangle = none.triangle;
+  for (int y = rect.y0; y < rect.y1; ++y) {
+    for (int x = rect.x0; x < rect.x1; x += kTileSize) {
+      const size_t width = size_t(std::min(rect.x1 - x, kTileSize));
+      const size_t row = local(x, y, 0), first = image->index(x, y);
+      const uint32_t* winners = &target.winners[target.index(x, y, 0)];
+      boxFilter(samples.color.data() + row, spp, width, color);
+      for (size_t i = 0; i < width; ++i) {
+        const size_t c = i * size_t(spp) + size_t(centreSample);
+        const uint32_t w = winners[c];
+        if (w == kNoSetup) {
+          depth[i] = none.depth;
+          instance[i] = none.instance;
+          triangle[i] = none.triangle;
+          // At 1 spp the sample's colour was not written: the full
+          // form's background colour, through the box filter.
+          if (spp == 1) color[i] = glm::vec4(0.0f);
+          continue;
+        }
+        if (w != last) {
+          last = w;
+          lastInstance = setups[w].instance;
+          lastTriangle = setups[w].triangle;
+        }
+        depth[i] = samples.depth[row + c];
+        instance[i] = lastInstance;
+        triangle[i] = lastTriangle;
+      }
+      streamCopy(image->color.data() + first, color, width * sizeof(glm::vec4));
+      streamCopy(image->depth.data() + first, depth, width * sizeof(float));
+      streamCopy(image->instance.data() + first, instance, width * sizeof(uint32_t));
+      streamCopy(image->triangle.data() + first, triangle, width * sizeof(uint32_t));
+    }
+  }
+  streamFence();
+}
+
 }  // namespace rastray
