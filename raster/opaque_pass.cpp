@@ -59,6 +59,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   };
   thread_local std::vector<Assignment> assignments;
   PrimaryBatch batch(primaryConstants_, scene_, setups_.data());
+  batch.wantInterpolated(!lean);  // the lean form reads no front hits
   PrimaryHitShader kernel(shader_, shadingPath());
   alignas(64) uint32_t localOut[kPrimaryHitBlock];  // the sample each is shaded at
   alignas(64) double footprintX[kPrimaryHitBlock],
