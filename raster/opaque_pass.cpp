@@ -33,10 +33,9 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   // Every sample is written exactly once below (a background sample in the
   // winner loop, a winner's hit and colour after the batch), so the
   // storage is only sized, never filled first. The lean form
-  // (raster/resolve.h) has no front hits, only the winners' depths, and at
-  // 1 spp no background colours (the resolve writes them).
+  // (raster/resolve.h) has no front hits, only the winners' depths, and no
+  // background samples (the resolve reads them as 0).
   const bool lean = samples.lean;
-  const bool backgroundColors = !lean || spp > 1;
   samples.color.resize(index.count());
   if (lean)
     samples.depth.resize(index.count());
@@ -58,6 +57,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     uint32_t source;  // the sample whose colour it takes
   };
   thread_local std::vector<Assignment> assignments;
+  thread_local std::vector<uint32_t> uniformPixels;  // shading rate pixel: first sample of each
   PrimaryBatch batch(primaryConstants_, scene_, setups_.data());
   batch.wantInterpolated(!lean);  // the lean form reads no front hits
   PrimaryHitShader kernel(shader_, shadingPath());
@@ -65,6 +65,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   alignas(64) double footprintX[kPrimaryHitBlock],
       footprintY[kPrimaryHitBlock];  // image position of the footprint
   assignments.clear();
+  uniformPixels.clear();
   const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
   // The block's hits into the tile's samples, then its colours. At
   // shading rate sample the footprint is at the sample: the batch's own
@@ -104,9 +105,6 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
           samples.color[local + i] = glm::vec4(0.0f);
           samples.front[local + i] = SampleHit{};
         }
-      } else if (backgroundColors) {
-        for (size_t i = 0; i < rowSamples; ++i)
-          if (rowWinners[i] == kNoSetup) samples.color[local + i] = glm::vec4(0.0f);
       }
       for (size_t i = 0; i < rowSamples;) {
         i = batch.addRow(rowWinners, i, rowSamples, spp, rect.x0, py, grid_.positions.data(), local,
@@ -122,14 +120,41 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
     uint32_t local = index(rect.x0, py, 0);
     for (int px = rect.x0; px < rect.x1; ++px) {
-      pixelCache.clear();
       const glm::dvec2 corner(px, py);
       const bool traced = trace.sink && px == trace.pixel.x && py == trace.pixel.y;
+      // A pixel whose samples were all won by one setup (a large
+      // triangle's inside), in the lean form: what the loop below does for
+      // it, without its per-sample search. Its first sample is shaded with
+      // the centre's footprint, the others take that colour, and the
+      // centre sample's depth is its own interpolated depth. A pixel of
+      // background alone: nothing to write.
+      const uint32_t first = rowWinners[0];
+      if (lean) {
+        int same = 1;
+        while (same < spp && rowWinners[same] == first) ++same;
+        if (same == spp) {
+          if (first != kNoSetup) {
+            const TriangleSetup& t = setups_[first];
+            addRequest(first, local, corner + grid_.positions[0], corner + glm::dvec2(0.5));
+            if (centre_ != 0) {
+              const glm::dvec2 c = corner + grid_.positions[size_t(centre_)];
+              samples.depth[local + uint32_t(centre_)] = float(t.viewDepthAt(c.x, c.y));
+            }
+            if (spp > 1) uniformPixels.push_back(local);
+          }
+          local += uint32_t(spp);
+          rowWinners += spp;
+          continue;
+        }
+      }
+      pixelCache.clear();
       for (int s = 0; s < spp; ++s, ++local) {
         const uint32_t win = *rowWinners++;
         if (win == kNoSetup) {
-          if (backgroundColors) samples.color[local] = glm::vec4(0.0f);
-          if (!lean) samples.front[local] = SampleHit{};
+          if (!lean) {
+            samples.color[local] = glm::vec4(0.0f);
+            samples.front[local] = SampleHit{};
+          }
           continue;
         }
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
@@ -141,7 +166,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
           // The sample's own hit only where someone reads it: the
           // resolve's centre sample, the per-sample hits, the trace.
           if (lean) {
-            if (s == centre_) samples.depth[local] = interpolatedHit(t, pos).depth;
+            if (s == centre_) samples.depth[local] = float(t.viewDepthAt(pos.x, pos.y));  // interpolatedHit's
           } else {
             samples.front[local] =
                 allFronts || s == centre_ || traced ? interpolatedHit(t, pos) : SampleHit{};
@@ -157,6 +182,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   if (batch.size() > 0) flush();
   // After every chunk: a source sample's colour is final.
   for (const Assignment& a : assignments) samples.color[a.local] = samples.color[a.source];
+  for (const uint32_t u : uniformPixels) std::fill_n(&samples.color[u + 1], spp - 1, samples.color[u]);
 
   if (trace.sink && trace.pixel.x >= rect.x0 && trace.pixel.x < rect.x1 && trace.pixel.y >= rect.y0 &&
       trace.pixel.y < rect.y1) {

@@ -111,6 +111,7 @@ HWY_AFTER_NAMESPACE();
 #include <algorithm>
 
 #include "common/primary_refinement.h"
+#include "common/sampling.h"
 #include "common/triangle_plane.h"
 
 namespace rastray {
@@ -179,13 +180,21 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
   if (rowY_ != y || rowSpp_ != spp || rowView_.size() < n) {
     rowY_ = y;
     rowSpp_ = spp;
-    rowYs_.resize(n);
-    rowView_.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      const double yy = double(y) + grid[i % size_t(spp)].y;
-      rowYs_[i] = yy;
-      rowView_[i] = (1.0 - (2.0 * yy) / camera_.height) * camera_.scale.y;
+    // Per sample of a pixel; at several samples, repeated along the row
+    // (at one, the spans below fill the block with the one value).
+    const size_t entries = spp == 1 ? 1 : n;
+    rowYs_.resize(entries);
+    rowView_.resize(entries);
+    double baseY[kMaxGridSide * kMaxGridSide], baseView[kMaxGridSide * kMaxGridSide];
+    for (int k = 0; k < spp; ++k) {
+      baseY[k] = double(y) + grid[k].y;
+      baseView[k] = (1.0 - (2.0 * baseY[k]) / camera_.height) * camera_.scale.y;
     }
+    for (size_t c = 0; c < entries; c += size_t(spp))
+      for (size_t k = 0; k < size_t(spp) && c + k < entries; ++k) {
+        rowYs_[c + k] = baseY[k];
+        rowView_[c + k] = baseView[k];
+      }
   }
   const double* const columnX = columnX_.data();
   const double* const columnView = columnView_.data();
@@ -215,18 +224,24 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
     const int32_t r = int32_t(runs - 1);
     if (m >= 8) {
       std::copy_n(columnX + i, m, b.x + used);
-      std::copy_n(rowY + i, m, b.y + used);
       std::copy_n(columnView + i, m, b.vx + used);
-      std::copy_n(rowView + i, m, b.vy + used);
+      if (spp == 1) {
+        std::fill_n(b.y + used, m, rowY[0]);
+        std::fill_n(b.vy + used, m, rowView[0]);
+      } else {
+        std::copy_n(rowY + i, m, b.y + used);
+        std::copy_n(rowView + i, m, b.vy + used);
+      }
       std::fill_n(b.run + used, m, int64_t(r));
       std::fill_n(b.run32 + used, m, r);
       for (size_t k = 0; k < m; ++k) localOut[used + k] = local0 + uint32_t(i + k);
     } else {
       for (size_t k = 0; k < m; ++k) {
         b.x[used + k] = columnX[i + k];
-        b.y[used + k] = rowY[i + k];
+        const size_t e = spp == 1 ? 0 : i + k;
+        b.y[used + k] = rowY[e];
         b.vx[used + k] = columnView[i + k];
-        b.vy[used + k] = rowView[i + k];
+        b.vy[used + k] = rowView[e];
         b.run[used + k] = int64_t(r);
         b.run32[used + k] = r;
         localOut[used + k] = local0 + uint32_t(i + k);

@@ -86,7 +86,8 @@ void resolveTileLean(const TileRect& rect, int spp, int centreSample, const Tile
       const size_t width = size_t(std::min(rect.x1 - x, kTileSize));
       const size_t row = local(x, y, 0), first = image->index(x, y);
       const uint32_t* winners = &target.winners[target.index(x, y, 0)];
-      boxFilter(samples.color.data() + row, spp, width, color);
+      // Samples without a winner hold no colour: the full form's 0.
+      boxFilterCovered(samples.color.data() + row, winners, kNoSetup, spp, width, color);
       for (size_t i = 0; i < width; ++i) {
         const size_t c = i * size_t(spp) + size_t(centreSample);
         const uint32_t w = winners[c];
@@ -94,9 +95,6 @@ void resolveTileLean(const TileRect& rect, int spp, int centreSample, const Tile
           depth[i] = none.depth;
           instance[i] = none.instance;
           triangle[i] = none.triangle;
-          // At 1 spp the sample's colour was not written: the full
-          // form's background colour, through the box filter.
-          if (spp == 1) color[i] = glm::vec4(0.0f);
           continue;
         }
         if (w != last) {

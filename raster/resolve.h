@@ -46,11 +46,10 @@ struct TileSampleIndex {
 // are its depth-test winner's (the resolve reads them from the depth
 // target), its depth is `depth`, set for every sample with a winner that
 // the resolve reads (the centre sample; the opaque pass sets it from the
-// same float as the full form's front hit); `color` is set for every
-// sample at several samples per pixel, and at one only for samples with a
-// winner (the resolve writes the others' zero itself). Why: at 1 spp the
-// 20-byte front hit per sample, and the background samples, were written
-// by the winner loop only for the resolve to read them back.
+// same float as the full form's front hit); `color` is set only for
+// samples with a winner (the resolve reads the others as the full form's
+// 0). Why: the 20-byte front hit per sample, and the background samples,
+// were written by the winner loop only for the resolve to read them back.
 struct TileSamples {
   std::vector<glm::vec4> color;  // composited, premultiplied
   std::vector<SampleHit> front;  // nearest visible surface per sample (full form)
@@ -64,7 +63,8 @@ void resolveTile(const TileRect& rect, int spp, int centreSample, const TileSamp
 // The lean form's: the same pixels as resolveTile given the full form
 // of the same tile, where front[i] = {setups[w].instance,
 // setups[w].triangle, depth[i]} for a sample won by w, SampleHit{} and
-// colour 0 for a sample without a winner (`target`'s kNoSetup).
+// colour 0 for a sample without a winner (`target`'s kNoSetup), whatever
+// its entries of `samples` hold.
 void resolveTileLean(const TileRect& rect, int spp, int centreSample, const TileSamples& samples,
                      const DepthTarget& target, const TriangleSetup* setups, FlatImage* image);
 

@@ -70,7 +70,7 @@ TEST(Resolve, WritesExactlyTheTilesPixelsAtAnyRowAlignment) {
 }
 
 // The lean form (no front hits; ids from the winners, depth per sample,
-// at 1 spp no background colours) against the full form of the same
+// no background colours) against the full form of the same
 // tile: the same bits in every pixel, background pixels and -0 colours
 // included, for a tile of the frame's target and a tile-local one.
 TEST(Resolve, LeanFormGivesTheFullFormsPixels) {
@@ -108,9 +108,8 @@ TEST(Resolve, LeanFormGivesTheFullFormsPixels) {
             if (w == kNoSetup) {
               full.color[i] = glm::vec4(0.0f);
               full.front[i] = SampleHit{};
-              // What the lean form holds there: unset at 1 spp (here
-              // stale values), 0 at several samples.
-              lean.color[i] = spp == 1 ? glm::vec4(nan, 2.0f, -0.0f, 3.0f) : glm::vec4(0.0f);
+              // What the lean form holds there: unset (here stale values).
+              lean.color[i] = glm::vec4(nan, 2.0f, -0.0f, 3.0f);
               lean.depth[i] = nan;
             } else {
               const float depth = 0.5f + v;
