@@ -102,6 +102,56 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
   }
 }
 
+// addRow's helpers. The end of the run of entries equal to `value` in
+// w[i, limit): i itself when w[i] differs.
+size_t LanesSpanEnd(const uint32_t* w, size_t i, size_t limit, uint32_t value) {
+  const hn::ScalableTag<uint32_t> du;
+  const size_t N = hn::Lanes(du);
+  const auto v = hn::Set(du, value);
+  for (; i + N <= limit; i += N) {
+    const auto differs = hn::Ne(hn::LoadU(du, w + i), v);
+    if (!hn::AllFalse(du, differs)) return i + size_t(hn::FindFirstTrue(du, differs));
+  }
+  while (i < limit && w[i] == value) ++i;
+  return i;
+}
+
+// Lanes [used, used + m) of the block from a span of row entries on run
+// r: image positions and view-plane vectors copied from the row's tables
+// (y and vy one value when `constantY`), the tile samples local, local + 1, ….
+void LanesFillSpan(primary_detail::FusedBlock* b, size_t used, size_t m, const double* x, const double* vx,
+                   const double* y, const double* vy, bool constantY, int32_t r, uint32_t local,
+                   uint32_t* localOut) {
+  const hn::ScalableTag<double> d;
+  const hn::RebindToSigned<decltype(d)> di;
+  const hn::Rebind<int32_t, decltype(d)> di32;
+  const hn::Rebind<uint32_t, decltype(d)> du32;
+  const size_t N = hn::Lanes(d);
+  const auto run = hn::Set(di, int64_t(r));
+  const auto run32 = hn::Set(di32, r);
+  size_t k = 0;
+  for (; k + N <= m; k += N) {
+    const size_t o = used + k;
+    hn::StoreU(hn::LoadU(d, x + k), d, b->x + o);
+    hn::StoreU(hn::LoadU(d, vx + k), d, b->vx + o);
+    hn::StoreU(constantY ? hn::Set(d, y[0]) : hn::LoadU(d, y + k), d, b->y + o);
+    hn::StoreU(constantY ? hn::Set(d, vy[0]) : hn::LoadU(d, vy + k), d, b->vy + o);
+    hn::StoreU(run, di, b->run + o);
+    hn::StoreU(run32, di32, b->run32 + o);
+    hn::StoreU(hn::Iota(du32, local + uint32_t(k)), du32, localOut + o);
+  }
+  for (; k < m; ++k) {
+    const size_t o = used + k;
+    b->x[o] = x[k];
+    b->vx[o] = vx[k];
+    b->y[o] = constantY ? y[0] : y[k];
+    b->vy[o] = constantY ? vy[0] : vy[k];
+    b->run[o] = int64_t(r);
+    b->run32[o] = r;
+    localOut[o] = local + uint32_t(k);
+  }
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace rastray
 HWY_AFTER_NAMESPACE();
@@ -118,6 +168,8 @@ namespace rastray {
 
 HWY_EXPORT(SampleLanes);
 HWY_EXPORT(LanesFusedPrimary);
+HWY_EXPORT(LanesSpanEnd);
+HWY_EXPORT(LanesFillSpan);
 
 PrimaryRayConstants::PrimaryRayConstants(const Camera& c)
     : camera(&c),
@@ -205,43 +257,41 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
   size_t used = used_, runs = runs_;
   uint32_t last = lastWinner_;
   size_t i = first;
+  // A span of entries on one winner: the first 8 looked at here, a
+  // longer one (a large triangle's row, a row of background) in lanes.
+  const auto spanEnd = [winners](size_t from, size_t limit, uint32_t value) {
+    const size_t quick = std::min(limit, from + 8);
+    while (from < quick && winners[from] == value) ++from;
+    return from == quick && from < limit ? HWY_DYNAMIC_DISPATCH(LanesSpanEnd)(winners, from, limit, value)
+                                         : from;
+  };
   while (i < n && used < primary_detail::kBlock) {
     const uint32_t win = winners[i];
     if (win == kNoSetup) {
-      ++i;
+      i = spanEnd(i + 1, n, kNoSetup);
       continue;
     }
     if (win != last || runs == 0) {
       fillRun(runs++, win);
       last = win;
     }
-    // The span of entries from i on this winner that fits the block (a
-    // large triangle's row of samples): copied table to block.
-    const size_t limit = std::min(n, i + (primary_detail::kBlock - used));
-    size_t end = i + 1;
-    while (end < limit && winners[end] == win) ++end;
+    // The span of entries from i on this winner that fits the block:
+    // copied table to block.
+    const size_t end = spanEnd(i + 1, std::min(n, i + (primary_detail::kBlock - used)), win);
     const size_t m = end - i;
     const int32_t r = int32_t(runs - 1);
+    const size_t e = spp == 1 ? 0 : i;  // the row tables' entry
     if (m >= 8) {
-      std::copy_n(columnX + i, m, b.x + used);
-      std::copy_n(columnView + i, m, b.vx + used);
-      if (spp == 1) {
-        std::fill_n(b.y + used, m, rowY[0]);
-        std::fill_n(b.vy + used, m, rowView[0]);
-      } else {
-        std::copy_n(rowY + i, m, b.y + used);
-        std::copy_n(rowView + i, m, b.vy + used);
-      }
-      std::fill_n(b.run + used, m, int64_t(r));
-      std::fill_n(b.run32 + used, m, r);
-      for (size_t k = 0; k < m; ++k) localOut[used + k] = local0 + uint32_t(i + k);
+      HWY_DYNAMIC_DISPATCH(LanesFillSpan)
+      (&b, used, m, columnX + i, columnView + i, rowY + e, rowView + e, spp == 1, r, local0 + uint32_t(i),
+       localOut);
     } else {
       for (size_t k = 0; k < m; ++k) {
+        const size_t ek = spp == 1 ? 0 : i + k;
         b.x[used + k] = columnX[i + k];
-        const size_t e = spp == 1 ? 0 : i + k;
-        b.y[used + k] = rowY[e];
+        b.y[used + k] = rowY[ek];
         b.vx[used + k] = columnView[i + k];
-        b.vy[used + k] = rowView[e];
+        b.vy[used + k] = rowView[ek];
         b.run[used + k] = int64_t(r);
         b.run32[used + k] = r;
         localOut[used + k] = local0 + uint32_t(i + k);
