@@ -319,6 +319,40 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   }
 }
 
+// Lanes [i0, i0 + n) of the block from one run of a PrimaryHitBlock:
+// run index r, the hits' directions and barycentrics (BlockShader::addRun).
+void LanesAppendRun(LaneBlock* b, size_t i0, size_t n, int32_t r, const double* dirX, const double* dirY,
+                    const double* dirZ, const float* b1, const float* b2) {
+  const hn::ScalableTag<double> d;
+  const hn::RebindToSigned<decltype(d)> di;
+  const hn::Rebind<int32_t, decltype(d)> di32;
+  const hn::Rebind<float, decltype(d)> df;
+  const size_t N = hn::Lanes(d);
+  const auto run = hn::Set(di32, r);
+  const auto run64 = hn::Set(di, int64_t(r));
+  size_t k = 0;
+  for (; k + N <= n; k += N) {
+    const size_t o = i0 + k;
+    hn::StoreU(run, di32, b->run + o);
+    hn::StoreU(run64, di, b->run64 + o);
+    hn::StoreU(hn::LoadU(d, dirX + k), d, b->dirXd + o);
+    hn::StoreU(hn::LoadU(d, dirY + k), d, b->dirYd + o);
+    hn::StoreU(hn::LoadU(d, dirZ + k), d, b->dirZd + o);
+    hn::StoreU(hn::LoadU(df, b1 + k), df, b->b1 + o);
+    hn::StoreU(hn::LoadU(df, b2 + k), df, b->b2 + o);
+  }
+  for (; k < n; ++k) {
+    const size_t o = i0 + k;
+    b->run[o] = r;
+    b->run64[o] = int64_t(r);
+    b->dirXd[o] = dirX[k];
+    b->dirYd[o] = dirY[k];
+    b->dirZd[o] = dirZ[k];
+    b->b1[o] = b1[k];
+    b->b2[o] = b2[k];
+  }
+}
+
 size_t RefineLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 // intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp})
@@ -378,6 +412,7 @@ HWY_EXPORT(LanesNormals);
 HWY_EXPORT(LanesLightWeight);
 HWY_EXPORT(LanesAccumulate);
 HWY_EXPORT(LanesFinish);
+HWY_EXPORT(LanesAppendRun);
 HWY_EXPORT(RefineLanes);
 HWY_EXPORT(LanesRefine);
 
@@ -555,13 +590,19 @@ class BlockShader {
     const size_t i0 = b.used, n = end - first;
     b.used += n;
     const int32_t r = int32_t(b.runs - 1);
-    std::fill_n(b.run + i0, n, r);
-    std::fill_n(b.run64 + i0, n, int64_t(r));
-    std::copy_n(h.dirX + first, n, b.dirXd + i0);
-    std::copy_n(h.dirY + first, n, b.dirYd + i0);
-    std::copy_n(h.dirZ + first, n, b.dirZd + i0);
-    std::copy_n(h.b1 + first, n, b.b1 + i0);
-    std::copy_n(h.b2 + first, n, b.b2 + i0);
+    if (n >= 16) {
+      // A large triangle's run: in lanes.
+      HWY_DYNAMIC_DISPATCH(LanesAppendRun)
+      (&b, i0, n, r, h.dirX + first, h.dirY + first, h.dirZ + first, h.b1 + first, h.b2 + first);
+    } else {
+      std::fill_n(b.run + i0, n, r);
+      std::fill_n(b.run64 + i0, n, int64_t(r));
+      std::copy_n(h.dirX + first, n, b.dirXd + i0);
+      std::copy_n(h.dirY + first, n, b.dirYd + i0);
+      std::copy_n(h.dirZ + first, n, b.dirZd + i0);
+      std::copy_n(h.b1 + first, n, b.b1 + i0);
+      std::copy_n(h.b2 + first, n, b.b2 + i0);
+    }
     if (b.colourPerLane) {
       std::fill_n(b.albedoR + i0, n, b.runAlbedoR[r]);
       std::fill_n(b.albedoG + i0, n, b.runAlbedoG[r]);
@@ -822,7 +863,11 @@ void PrimaryHitShader::shade(const PrimaryHitBlock& h, glm::vec4* colors) {
   }
   for (size_t first = 0, end = 0; first < h.count; first = end) {
     const int32_t run = h.run[first];
-    for (end = first + 1; end < h.count && h.run[end] == run; ++end) {
+    if (h.runFirst) {
+      end = h.runFirst[run + 1];
+    } else {
+      for (end = first + 1; end < h.count && h.run[end] == run; ++end) {
+      }
     }
     const uint32_t instance = h.runInstance[run];
     if (instance != s.runInstance) {

@@ -272,7 +272,7 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
       continue;
     }
     if (win != last || runs == 0) {
-      fillRun(runs++, win);
+      fillRun(runs++, win, used);
       last = win;
     }
     // The span of entries from i on this winner that fits the block:
@@ -307,7 +307,7 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
 }
 
 // Run r: its setup's planes and its stored triangle's plane.
-void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
+void PrimaryBatch::fillRun(size_t r, uint32_t winner, size_t firstLane) {
   primary_detail::FusedBlock& b = *block_;
   const TriangleSetup& t = setups_[winner];
   runSetup_[r] = &t;
@@ -338,6 +338,7 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
   b.e2DotQ[r] = p.e2DotQ;
   b.slot1[r] = p.slot1;
   b.slot2[r] = p.slot2;
+  runFirst_[r] = uint32_t(firstLane);
   runInstance_[r] = t.instance;
   runTriangle_[r] = t.triangle;
 }
@@ -382,8 +383,11 @@ void PrimaryBatch::run() {
 }
 
 PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footprintY,
-                                   const uint32_t* colorIndex) const {
+                                   const uint32_t* colorIndex) {
+  runFirst_[runs_] = uint32_t(used_);
   PrimaryHitBlock h;
+  h.runs = runs_;
+  h.runFirst = runFirst_;
   h.count = used_;
   h.run = block_->run32;
   h.runInstance = runInstance_;

@@ -125,7 +125,7 @@ class PrimaryBatch {
     block_->x[k] = x;
     block_->y[k] = y;
     if (winner != lastWinner_ || runs_ == 0) {
-      fillRun(runs_++, winner);
+      fillRun(runs_++, winner, k);
       lastWinner_ = winner;
     }
     block_->run[k] = int64_t(runs_ - 1);
@@ -156,7 +156,7 @@ class PrimaryBatch {
   void wantInterpolated(bool want) { block_->wantInterpolated = want; }
   // The refined hits for the kernel; footprints and colour indices are the
   // caller's (per sample, in the order added).
-  PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex) const;
+  PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex);
   void clear() {
     used_ = 0;
     runs_ = 0;
@@ -164,7 +164,7 @@ class PrimaryBatch {
   }
 
  private:
-  void fillRun(size_t r, uint32_t winner);  // run r's table entry
+  void fillRun(size_t r, uint32_t winner, size_t firstLane);  // run r's table entry
 
   const PrimaryRayConstants& camera_;
   const Scene& scene_;
@@ -175,6 +175,7 @@ class PrimaryBatch {
   const TriangleSetup* runSetup_[primary_detail::kBlock];
   // Per run and per sample, for the kernel (after run()).
   uint32_t runInstance_[primary_detail::kBlock], runTriangle_[primary_detail::kBlock];
+  uint32_t runFirst_[primary_detail::kBlock + 1];  // each run's first sample, then used_ (hits())
   // The stored triangle's plane as a run needs it (with the eye-dependent
   // terms as intersectTrianglePlane's memo computes them), for recent
   // triangles: a function of the triangle and the eye alone, cached by
