@@ -353,6 +353,23 @@ void LanesAppendRun(LaneBlock* b, size_t i0, size_t n, int32_t r, const double* 
   }
 }
 
+// out[i] = (outR, outG, outB, outA)[i] for the block's used lanes: its
+// colours to consecutive RGBA pixels.
+void LanesStoreColors(const LaneBlock* b, float* out) {
+  const hn::ScalableTag<float> d;
+  const size_t N = hn::Lanes(d);
+  size_t i = 0;
+  for (; i + N <= b->used; i += N)
+    hn::StoreInterleaved4(hn::Load(d, b->outR + i), hn::Load(d, b->outG + i), hn::Load(d, b->outB + i),
+                          hn::Load(d, b->outA + i), d, out + 4 * i);
+  for (; i < b->used; ++i) {
+    out[4 * i] = b->outR[i];
+    out[4 * i + 1] = b->outG[i];
+    out[4 * i + 2] = b->outB[i];
+    out[4 * i + 3] = b->outA[i];
+  }
+}
+
 size_t RefineLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 // intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp})
@@ -413,6 +430,7 @@ HWY_EXPORT(LanesLightWeight);
 HWY_EXPORT(LanesAccumulate);
 HWY_EXPORT(LanesFinish);
 HWY_EXPORT(LanesAppendRun);
+HWY_EXPORT(LanesStoreColors);
 HWY_EXPORT(RefineLanes);
 HWY_EXPORT(LanesRefine);
 
@@ -514,6 +532,7 @@ class BlockShader {
     colourPerLane();
     const size_t i = b.used++;
     outputs_[i] = out;
+    contiguous_ = contiguous_ && (i == 0 || out == outputs_[i - 1] + 1);
     // Consecutive hits mostly share a triangle: its data is looked up once
     // per run (the same values, so the lane does not depend on the run).
     enterRun(h.instance, h.triangle, m);
@@ -612,7 +631,14 @@ class BlockShader {
       std::fill_n(b.emitB + i0, n, b.runEmitB[r]);
       std::fill_n(b.alpha + i0, n, b.runAlpha[r]);
     }
-    for (size_t k = 0; k < n; ++k) outputs_[i0 + k] = &colors[h.colorIndex[first + k]];
+    bool contiguous = contiguous_ && (i0 == 0 || &colors[h.colorIndex[first]] == outputs_[i0 - 1] + 1);
+    const uint32_t c0 = h.colorIndex[first];
+    for (size_t k = 0; k < n; ++k) {
+      const uint32_t c = h.colorIndex[first + k];
+      outputs_[i0 + k] = &colors[c];
+      contiguous = contiguous && c == c0 + uint32_t(k);
+    }
+    contiguous_ = contiguous;
   }
 
   // Shades the gathered lanes and writes their colours; empties the block.
@@ -656,7 +682,15 @@ class BlockShader {
       }
     }
     HWY_DYNAMIC_DISPATCH(LanesFinish)(&b, eyeLight);
-    for (size_t i = 0; i < b.used; ++i) *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
+    if (contiguous_) {
+      // The lanes' colours go to consecutive pixels (a run of samples
+      // along a tile row): written interleaved in lanes.
+      HWY_DYNAMIC_DISPATCH(LanesStoreColors)(&b, &outputs_[0]->x);
+    } else {
+      for (size_t i = 0; i < b.used; ++i)
+        *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
+    }
+    contiguous_ = true;
     b.used = 0;
     b.runs = 0;
     b.colourPerLane = false;
@@ -791,6 +825,7 @@ class BlockShader {
   std::unique_ptr<unsigned char[]> runCache_{new unsigned char[sizeof(TriangleRun) << kRunCacheBits]};
   LaneBlock block_;
   glm::vec4* outputs_[kBlock];
+  bool contiguous_ = true;       // outputs_[i] == outputs_[0] + i for every used lane
   SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback
 };
 
