@@ -38,7 +38,7 @@ void BoxFilterLanes(const float* samples, int spp, size_t pixels, float* out) {
 }
 
 void BoxFilterCoveredLanes(const float* samples, const uint32_t* covered, uint32_t uncovered, int spp,
-                           size_t pixels, float* out) {
+                           size_t pixels, float* out, bool shareUniform) {
   // One RGBA pixel per 4-lane vector (in pieces where the target has fewer
   // lanes); an uncovered sample adds +0, as its stored 0 would.
   const hn::CappedTag<float, 4> d4;
@@ -47,6 +47,19 @@ void BoxFilterCoveredLanes(const float* samples, const uint32_t* covered, uint32
   for (size_t p = 0; p < pixels; ++p) {
     const float* s = samples + 4 * size_t(spp) * p;
     const uint32_t* c = covered + size_t(spp) * p;
+    if (shareUniform && c[0] != uncovered) {
+      int same = 1;
+      while (same < spp && c[same] == c[0]) ++same;
+      if (same == spp) {
+        for (size_t k = 0; k < 4; k += lanes) {
+          const auto v = hn::LoadU(d4, s + k);
+          auto sum = zero;
+          for (int j = 0; j < spp; ++j) sum = hn::Add(sum, v);
+          hn::StoreU(hn::Div(sum, count), d4, out + 4 * p + k);
+        }
+        continue;
+      }
+    }
     for (size_t k = 0; k < 4; k += lanes) {
       auto sum = zero;
       for (int j = 0; j < spp; ++j)
@@ -75,9 +88,10 @@ void boxFilter(const glm::vec4* samples, int spp, size_t pixels, glm::vec4* out)
 }
 
 void boxFilterCovered(const glm::vec4* samples, const uint32_t* covered, uint32_t uncovered, int spp,
-                      size_t pixels, glm::vec4* out) {
+                      size_t pixels, glm::vec4* out, bool shareUniform) {
   if (pixels == 0) return;
-  HWY_DYNAMIC_DISPATCH(BoxFilterCoveredLanes)(&samples[0].x, covered, uncovered, spp, pixels, &out[0].x);
+  HWY_DYNAMIC_DISPATCH(BoxFilterCoveredLanes)
+  (&samples[0].x, covered, uncovered, spp, pixels, &out[0].x, shareUniform);
 }
 
 }  // namespace rastray

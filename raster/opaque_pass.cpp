@@ -36,6 +36,8 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   // (raster/resolve.h) has no front hits, only the winners' depths, and no
   // background samples (the resolve reads them as 0).
   const bool lean = samples.lean;
+  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
+  samples.uniformShared = lean && pixelRate;
   samples.color.resize(index.count());
   if (lean)
     samples.depth.resize(index.count());
@@ -57,7 +59,6 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     uint32_t source;  // the sample whose colour it takes
   };
   thread_local std::vector<Assignment> assignments;
-  thread_local std::vector<uint32_t> uniformPixels;  // shading rate pixel: first sample of each
   PrimaryBatch batch(primaryConstants_, scene_, setups_.data());
   batch.wantInterpolated(!lean);  // the lean form reads no front hits
   PrimaryHitShader kernel(shader_, shadingPath());
@@ -65,8 +66,6 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   alignas(64) double footprintX[kPrimaryHitBlock],
       footprintY[kPrimaryHitBlock];  // image position of the footprint
   assignments.clear();
-  uniformPixels.clear();
-  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
   // The block's hits into the tile's samples, then its colours. At
   // shading rate sample the footprint is at the sample: the batch's own
   // positions.
@@ -126,8 +125,10 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
       // triangle's inside), in the lean form: what the loop below does for
       // it, without its per-sample search. Its first sample is shaded with
       // the centre's footprint, the others take that colour, and the
-      // centre sample's depth is its own interpolated depth. A pixel of
-      // background alone: nothing to write.
+      // centre sample's depth is its own interpolated depth; the resolve
+      // reads the first sample's colour for the others
+      // (TileSamples::uniformShared). A pixel of background alone:
+      // nothing to write.
       const uint32_t first = rowWinners[0];
       if (lean) {
         int same = 1;
@@ -140,7 +141,6 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
               const glm::dvec2 c = corner + grid_.positions[size_t(centre_)];
               samples.depth[local + uint32_t(centre_)] = float(t.viewDepthAt(c.x, c.y));
             }
-            if (spp > 1) uniformPixels.push_back(local);
           }
           local += uint32_t(spp);
           rowWinners += spp;
@@ -182,7 +182,6 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   if (batch.size() > 0) flush();
   // After every chunk: a source sample's colour is final.
   for (const Assignment& a : assignments) samples.color[a.local] = samples.color[a.source];
-  for (const uint32_t u : uniformPixels) std::fill_n(&samples.color[u + 1], spp - 1, samples.color[u]);
 
   if (trace.sink && trace.pixel.x >= rect.x0 && trace.pixel.x < rect.x1 && trace.pixel.y >= rect.y0 &&
       trace.pixel.y < rect.y1) {

@@ -173,7 +173,8 @@ void resolveTileLean(const TileRect& rect, int spp, int centreSample, const Tile
         continue;
       }
       // Samples without a winner hold no colour: the full form's 0.
-      boxFilterCovered(samples.color.data() + row, winners, kNoSetup, spp, width, color);
+      boxFilterCovered(samples.color.data() + row, winners, kNoSetup, spp, width, color,
+                       samples.uniformShared);
       for (size_t i = 0; i < width; ++i) {
         const size_t c = i * size_t(spp) + size_t(centreSample);
         const uint32_t w = winners[c];

@@ -55,6 +55,10 @@ struct TileSamples {
   std::vector<SampleHit> front;  // nearest visible surface per sample (full form)
   std::vector<float> depth;      // the winner's interpolated depth (lean form)
   bool lean = false;
+  // Lean form, shading once per pixel: a pixel whose samples were all won
+  // by one setup holds its colour in its first sample only (the others
+  // take it: the resolve reads it for them).
+  bool uniformShared = false;
 };
 
 // The full form's resolve.
