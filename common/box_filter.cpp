@@ -37,6 +37,38 @@ void BoxFilterLanes(const float* samples, int spp, size_t pixels, float* out) {
   }
 }
 
+void BoxFilterCoveredLanes(const float* samples, const uint32_t* covered, uint32_t uncovered, int spp,
+                           size_t pixels, float* out, bool shareUniform) {
+  // One RGBA pixel per 4-lane vector (in pieces where the target has fewer
+  // lanes); an uncovered sample adds +0, as its stored 0 would.
+  const hn::CappedTag<float, 4> d4;
+  const size_t lanes = hn::Lanes(d4);
+  const auto count = hn::Set(d4, float(spp)), zero = hn::Zero(d4);
+  for (size_t p = 0; p < pixels; ++p) {
+    const float* s = samples + 4 * size_t(spp) * p;
+    const uint32_t* c = covered + size_t(spp) * p;
+    if (shareUniform && c[0] != uncovered) {
+      int same = 1;
+      while (same < spp && c[same] == c[0]) ++same;
+      if (same == spp) {
+        for (size_t k = 0; k < 4; k += lanes) {
+          const auto v = hn::LoadU(d4, s + k);
+          auto sum = zero;
+          for (int j = 0; j < spp; ++j) sum = hn::Add(sum, v);
+          hn::StoreU(hn::Div(sum, count), d4, out + 4 * p + k);
+        }
+        continue;
+      }
+    }
+    for (size_t k = 0; k < 4; k += lanes) {
+      auto sum = zero;
+      for (int j = 0; j < spp; ++j)
+        sum = hn::Add(sum, c[j] == uncovered ? zero : hn::LoadU(d4, s + 4 * size_t(j) + k));
+      hn::StoreU(hn::Div(sum, count), d4, out + 4 * p + k);
+    }
+  }
+}
+
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE
 }  // namespace rastray
@@ -48,10 +80,18 @@ namespace rastray {
 static_assert(sizeof(glm::vec4) == 4 * sizeof(float), "glm::vec4 is four packed floats");
 
 HWY_EXPORT(BoxFilterLanes);
+HWY_EXPORT(BoxFilterCoveredLanes);
 
 void boxFilter(const glm::vec4* samples, int spp, size_t pixels, glm::vec4* out) {
   if (pixels == 0) return;
   HWY_DYNAMIC_DISPATCH(BoxFilterLanes)(&samples[0].x, spp, pixels, &out[0].x);
+}
+
+void boxFilterCovered(const glm::vec4* samples, const uint32_t* covered, uint32_t uncovered, int spp,
+                      size_t pixels, glm::vec4* out, bool shareUniform) {
+  if (pixels == 0) return;
+  HWY_DYNAMIC_DISPATCH(BoxFilterCoveredLanes)
+  (&samples[0].x, covered, uncovered, spp, pixels, &out[0].x, shareUniform);
 }
 
 }  // namespace rastray

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include <glm/glm.hpp>
 
@@ -13,5 +14,16 @@ namespace rastray {
 // out[p] = (0 + samples[p·spp] + … + samples[p·spp + spp − 1]) / spp for
 // p < pixels, in SIMD lanes (Highway, chosen at run time).
 void boxFilter(const glm::vec4* samples, int spp, size_t pixels, glm::vec4* out);
+
+// boxFilter with samples[i] read as 0 where covered[i] == uncovered (and
+// not read at all there): the same bits as boxFilter over a copy of
+// `samples` with those entries set to 0. For a caller that does not write
+// its empty samples (raster/resolve.h, the lean form).
+// With `shareUniform`, a pixel whose samples all hold one covered value
+// reads its first sample's colour for every sample (the others are not
+// read): the bits of boxFilter over a copy where they hold that colour too
+// (shading once per pixel: such a pixel's samples share one colour).
+void boxFilterCovered(const glm::vec4* samples, const uint32_t* covered, uint32_t uncovered, int spp,
+                      size_t pixels, glm::vec4* out, bool shareUniform = false);
 
 }  // namespace rastray

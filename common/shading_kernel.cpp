@@ -319,6 +319,57 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   }
 }
 
+// Lanes [i0, i0 + n) of the block from one run of a PrimaryHitBlock:
+// run index r, the hits' directions and barycentrics (BlockShader::addRun).
+void LanesAppendRun(LaneBlock* b, size_t i0, size_t n, int32_t r, const double* dirX, const double* dirY,
+                    const double* dirZ, const float* b1, const float* b2) {
+  const hn::ScalableTag<double> d;
+  const hn::RebindToSigned<decltype(d)> di;
+  const hn::Rebind<int32_t, decltype(d)> di32;
+  const hn::Rebind<float, decltype(d)> df;
+  const size_t N = hn::Lanes(d);
+  const auto run = hn::Set(di32, r);
+  const auto run64 = hn::Set(di, int64_t(r));
+  size_t k = 0;
+  for (; k + N <= n; k += N) {
+    const size_t o = i0 + k;
+    hn::StoreU(run, di32, b->run + o);
+    hn::StoreU(run64, di, b->run64 + o);
+    hn::StoreU(hn::LoadU(d, dirX + k), d, b->dirXd + o);
+    hn::StoreU(hn::LoadU(d, dirY + k), d, b->dirYd + o);
+    hn::StoreU(hn::LoadU(d, dirZ + k), d, b->dirZd + o);
+    hn::StoreU(hn::LoadU(df, b1 + k), df, b->b1 + o);
+    hn::StoreU(hn::LoadU(df, b2 + k), df, b->b2 + o);
+  }
+  for (; k < n; ++k) {
+    const size_t o = i0 + k;
+    b->run[o] = r;
+    b->run64[o] = int64_t(r);
+    b->dirXd[o] = dirX[k];
+    b->dirYd[o] = dirY[k];
+    b->dirZd[o] = dirZ[k];
+    b->b1[o] = b1[k];
+    b->b2[o] = b2[k];
+  }
+}
+
+// out[i] = (outR, outG, outB, outA)[i] for the block's used lanes: its
+// colours to consecutive RGBA pixels.
+void LanesStoreColors(const LaneBlock* b, float* out) {
+  const hn::ScalableTag<float> d;
+  const size_t N = hn::Lanes(d);
+  size_t i = 0;
+  for (; i + N <= b->used; i += N)
+    hn::StoreInterleaved4(hn::Load(d, b->outR + i), hn::Load(d, b->outG + i), hn::Load(d, b->outB + i),
+                          hn::Load(d, b->outA + i), d, out + 4 * i);
+  for (; i < b->used; ++i) {
+    out[4 * i] = b->outR[i];
+    out[4 * i + 1] = b->outG[i];
+    out[4 * i + 2] = b->outB[i];
+    out[4 * i + 3] = b->outA[i];
+  }
+}
+
 size_t RefineLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 // intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp})
@@ -378,6 +429,8 @@ HWY_EXPORT(LanesNormals);
 HWY_EXPORT(LanesLightWeight);
 HWY_EXPORT(LanesAccumulate);
 HWY_EXPORT(LanesFinish);
+HWY_EXPORT(LanesAppendRun);
+HWY_EXPORT(LanesStoreColors);
 HWY_EXPORT(RefineLanes);
 HWY_EXPORT(LanesRefine);
 
@@ -479,6 +532,7 @@ class BlockShader {
     colourPerLane();
     const size_t i = b.used++;
     outputs_[i] = out;
+    contiguous_ = contiguous_ && (i == 0 || out == outputs_[i - 1] + 1);
     // Consecutive hits mostly share a triangle: its data is looked up once
     // per run (the same values, so the lane does not depend on the run).
     enterRun(h.instance, h.triangle, m);
@@ -555,13 +609,19 @@ class BlockShader {
     const size_t i0 = b.used, n = end - first;
     b.used += n;
     const int32_t r = int32_t(b.runs - 1);
-    std::fill_n(b.run + i0, n, r);
-    std::fill_n(b.run64 + i0, n, int64_t(r));
-    std::copy_n(h.dirX + first, n, b.dirXd + i0);
-    std::copy_n(h.dirY + first, n, b.dirYd + i0);
-    std::copy_n(h.dirZ + first, n, b.dirZd + i0);
-    std::copy_n(h.b1 + first, n, b.b1 + i0);
-    std::copy_n(h.b2 + first, n, b.b2 + i0);
+    if (n >= 16) {
+      // A large triangle's run: in lanes.
+      HWY_DYNAMIC_DISPATCH(LanesAppendRun)
+      (&b, i0, n, r, h.dirX + first, h.dirY + first, h.dirZ + first, h.b1 + first, h.b2 + first);
+    } else {
+      std::fill_n(b.run + i0, n, r);
+      std::fill_n(b.run64 + i0, n, int64_t(r));
+      std::copy_n(h.dirX + first, n, b.dirXd + i0);
+      std::copy_n(h.dirY + first, n, b.dirYd + i0);
+      std::copy_n(h.dirZ + first, n, b.dirZd + i0);
+      std::copy_n(h.b1 + first, n, b.b1 + i0);
+      std::copy_n(h.b2 + first, n, b.b2 + i0);
+    }
     if (b.colourPerLane) {
       std::fill_n(b.albedoR + i0, n, b.runAlbedoR[r]);
       std::fill_n(b.albedoG + i0, n, b.runAlbedoG[r]);
@@ -571,7 +631,14 @@ class BlockShader {
       std::fill_n(b.emitB + i0, n, b.runEmitB[r]);
       std::fill_n(b.alpha + i0, n, b.runAlpha[r]);
     }
-    for (size_t k = 0; k < n; ++k) outputs_[i0 + k] = &colors[h.colorIndex[first + k]];
+    bool contiguous = contiguous_ && (i0 == 0 || &colors[h.colorIndex[first]] == outputs_[i0 - 1] + 1);
+    const uint32_t c0 = h.colorIndex[first];
+    for (size_t k = 0; k < n; ++k) {
+      const uint32_t c = h.colorIndex[first + k];
+      outputs_[i0 + k] = &colors[c];
+      contiguous = contiguous && c == c0 + uint32_t(k);
+    }
+    contiguous_ = contiguous;
   }
 
   // Shades the gathered lanes and writes their colours; empties the block.
@@ -615,7 +682,15 @@ class BlockShader {
       }
     }
     HWY_DYNAMIC_DISPATCH(LanesFinish)(&b, eyeLight);
-    for (size_t i = 0; i < b.used; ++i) *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
+    if (contiguous_) {
+      // The lanes' colours go to consecutive pixels (a run of samples
+      // along a tile row): written interleaved in lanes.
+      HWY_DYNAMIC_DISPATCH(LanesStoreColors)(&b, &outputs_[0]->x);
+    } else {
+      for (size_t i = 0; i < b.used; ++i)
+        *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
+    }
+    contiguous_ = true;
     b.used = 0;
     b.runs = 0;
     b.colourPerLane = false;
@@ -750,6 +825,7 @@ class BlockShader {
   std::unique_ptr<unsigned char[]> runCache_{new unsigned char[sizeof(TriangleRun) << kRunCacheBits]};
   LaneBlock block_;
   glm::vec4* outputs_[kBlock];
+  bool contiguous_ = true;       // outputs_[i] == outputs_[0] + i for every used lane
   SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback
 };
 
@@ -822,7 +898,11 @@ void PrimaryHitShader::shade(const PrimaryHitBlock& h, glm::vec4* colors) {
   }
   for (size_t first = 0, end = 0; first < h.count; first = end) {
     const int32_t run = h.run[first];
-    for (end = first + 1; end < h.count && h.run[end] == run; ++end) {
+    if (h.runFirst) {
+      end = h.runFirst[run + 1];
+    } else {
+      for (end = first + 1; end < h.count && h.run[end] == run; ++end) {
+      }
     }
     const uint32_t instance = h.runInstance[run];
     if (instance != s.runInstance) {

@@ -131,6 +131,10 @@ struct PrimaryHitBlock {
   const float *b1 = nullptr, *b2 = nullptr;                        // per hit: refined
   const double *footprintX = nullptr, *footprintY = nullptr;       // per hit: image position of the footprint
   const uint32_t* colorIndex = nullptr;                            // per hit
+  // Optional: the first hit of each run (runs + 1 entries, the last one
+  // `count`), so the kernel need not look for where runs change.
+  size_t runs = 0;
+  const uint32_t* runFirst = nullptr;
 };
 
 // The kernel for blocks of hits (PrimaryHitBlock), built once per caller

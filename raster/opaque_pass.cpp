@@ -32,9 +32,17 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   const int spp = grid_.spp;
   // Every sample is written exactly once below (a background sample in the
   // winner loop, a winner's hit and colour after the batch), so the
-  // storage is only sized, never filled first.
+  // storage is only sized, never filled first. The lean form
+  // (raster/resolve.h) has no front hits, only the winners' depths, and no
+  // background samples (the resolve reads them as 0).
+  const bool lean = samples.lean;
+  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
+  samples.uniformShared = lean && pixelRate;
   samples.color.resize(index.count());
-  samples.front.resize(index.count());
+  if (lean)
+    samples.depth.resize(index.count());
+  else
+    samples.front.resize(index.count());
   // The tile's winning samples a block of kPrimaryHitBlock at a time, in
   // pixel and sample order: the winner loop adds each to the fused pass's
   // block (PrimaryBatch: the interpolated hit, the primary ray and the hit
@@ -52,12 +60,12 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   };
   thread_local std::vector<Assignment> assignments;
   PrimaryBatch batch(primaryConstants_, scene_, setups_.data());
+  batch.wantInterpolated(!lean);  // the lean form reads no front hits
   PrimaryHitShader kernel(shader_, shadingPath());
   alignas(64) uint32_t localOut[kPrimaryHitBlock];  // the sample each is shaded at
   alignas(64) double footprintX[kPrimaryHitBlock],
       footprintY[kPrimaryHitBlock];  // image position of the footprint
   assignments.clear();
-  const bool pixelRate = options_.shadingRate == ShadingRate::Pixel;
   // The block's hits into the tile's samples, then its colours. At
   // shading rate sample the footprint is at the sample: the batch's own
   // positions.
@@ -66,7 +74,11 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   const auto flush = [&] {
     batch.run();
     const size_t count = batch.size();
-    for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = batch.hit(r);
+    if (lean) {
+      for (size_t r = 0; r < count; ++r) samples.depth[localOut[r]] = batch.depth(r);
+    } else {
+      for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = batch.hit(r);
+    }
     kernel.shade(batch.hits(fpX, fpY, localOut), samples.color.data());
     n.shadedSamples += count;
     batch.clear();
@@ -86,10 +98,12 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     for (int py = rect.y0; py < rect.y1; ++py) {
       const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
       const uint32_t local = index(rect.x0, py, 0);
-      for (size_t i = 0; i < rowSamples; ++i) {
-        if (rowWinners[i] != kNoSetup) continue;
-        samples.color[local + i] = glm::vec4(0.0f);
-        samples.front[local + i] = SampleHit{};
+      if (!lean) {
+        for (size_t i = 0; i < rowSamples; ++i) {
+          if (rowWinners[i] != kNoSetup) continue;
+          samples.color[local + i] = glm::vec4(0.0f);
+          samples.front[local + i] = SampleHit{};
+        }
       }
       for (size_t i = 0; i < rowSamples;) {
         i = batch.addRow(rowWinners, i, rowSamples, spp, rect.x0, py, grid_.positions.data(), local,
@@ -105,14 +119,42 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     const uint32_t* rowWinners = &target.winners[target.index(rect.x0, py, 0)];
     uint32_t local = index(rect.x0, py, 0);
     for (int px = rect.x0; px < rect.x1; ++px) {
-      pixelCache.clear();
       const glm::dvec2 corner(px, py);
       const bool traced = trace.sink && px == trace.pixel.x && py == trace.pixel.y;
+      // A pixel whose samples were all won by one setup (a large
+      // triangle's inside), in the lean form: what the loop below does for
+      // it, without its per-sample search. Its first sample is shaded with
+      // the centre's footprint, the others take that colour, and the
+      // centre sample's depth is its own interpolated depth; the resolve
+      // reads the first sample's colour for the others
+      // (TileSamples::uniformShared). A pixel of background alone:
+      // nothing to write.
+      const uint32_t first = rowWinners[0];
+      if (lean) {
+        int same = 1;
+        while (same < spp && rowWinners[same] == first) ++same;
+        if (same == spp) {
+          if (first != kNoSetup) {
+            const TriangleSetup& t = setups_[first];
+            addRequest(first, local, corner + grid_.positions[0], corner + glm::dvec2(0.5));
+            if (centre_ != 0) {
+              const glm::dvec2 c = corner + grid_.positions[size_t(centre_)];
+              samples.depth[local + uint32_t(centre_)] = float(t.viewDepthAt(c.x, c.y));
+            }
+          }
+          local += uint32_t(spp);
+          rowWinners += spp;
+          continue;
+        }
+      }
+      pixelCache.clear();
       for (int s = 0; s < spp; ++s, ++local) {
         const uint32_t win = *rowWinners++;
         if (win == kNoSetup) {
-          samples.color[local] = glm::vec4(0.0f);
-          samples.front[local] = SampleHit{};
+          if (!lean) {
+            samples.color[local] = glm::vec4(0.0f);
+            samples.front[local] = SampleHit{};
+          }
           continue;
         }
         const glm::dvec2 pos = corner + grid_.positions[size_t(s)];
@@ -123,7 +165,12 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
           assignments.push_back({local, it->second});
           // The sample's own hit only where someone reads it: the
           // resolve's centre sample, the per-sample hits, the trace.
-          samples.front[local] = allFronts || s == centre_ || traced ? interpolatedHit(t, pos) : SampleHit{};
+          if (lean) {
+            if (s == centre_) samples.depth[local] = float(t.viewDepthAt(pos.x, pos.y));  // interpolatedHit's
+          } else {
+            samples.front[local] =
+                allFronts || s == centre_ || traced ? interpolatedHit(t, pos) : SampleHit{};
+          }
         } else {
           // First covered sample of this triangle, footprint of the pixel centre (MSAA-like).
           addRequest(win, local, pos, corner + glm::dvec2(0.5));

@@ -33,6 +33,7 @@ size_t SampleLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 // refinePrimaryHits.
 void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants* c) {
   const hn::ScalableTag<double> d;
+  const hn::Rebind<float, decltype(d)> df;  // the float outputs, one per double lane
   const size_t N = hn::Lanes(d);
   const auto one = hn::Set(d, 1.0), two = hn::Set(d, 2.0);
   const auto width = hn::Set(d, c->width), height = hn::Set(d, c->height);
@@ -49,10 +50,7 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
       return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox)), hn::Mul(get(dy), oy));
     };
     const auto invW = plane(b->iw0, b->iwx, b->iwy);
-    hn::Store(hn::Div(plane(b->dw0, b->dwx, b->dwy), invW), d, b->depth + i);
-    const auto inv = hn::Div(one, invW);
-    hn::Store(hn::Mul(plane(b->b10, b->b1x, b->b1y), inv), d, b->b1 + i);
-    hn::Store(hn::Mul(plane(b->b20, b->b2x, b->b2y), inv), d, b->b2 + i);
+    hn::Store(hn::DemoteTo(df, hn::Div(plane(b->dw0, b->dwx, b->dwy), invW)), df, b->depth + i);
 
     hn::Vec<decltype(d)> vx, vy;
     if (b->haveView) {
@@ -89,9 +87,68 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     // mask without a square root and a division per lane (tested against
     // refinePrimaryHit, which uses the ray's own depthPerT).
     const auto ok = RefineOnPlane(d, dirX, dirY, dirZ, one, pl, &rb1, &rb2);
-    hn::Store(rb1, d, b->rb1 + i);
-    hn::Store(rb2, d, b->rb2 + i);
-    hn::Store(hn::IfThenElseZero(ok, one), d, b->refined + i);
+    // The interpolated barycentrics (a division) only where they are read.
+    if (b->wantInterpolated || !hn::AllTrue(d, ok)) {
+      const auto inv = hn::Div(one, invW);
+      const auto b1 = hn::Mul(plane(b->b10, b->b1x, b->b1y), inv);
+      const auto b2 = hn::Mul(plane(b->b20, b->b2x, b->b2y), inv);
+      hn::Store(b1, d, b->b1 + i);
+      hn::Store(b2, d, b->b2 + i);
+      rb1 = hn::IfThenElse(ok, rb1, b1);
+      rb2 = hn::IfThenElse(ok, rb2, b2);
+    }
+    hn::Store(hn::DemoteTo(df, rb1), df, b->kb1 + i);
+    hn::Store(hn::DemoteTo(df, rb2), df, b->kb2 + i);
+  }
+}
+
+// addRow's helpers. The end of the run of entries equal to `value` in
+// w[i, limit): i itself when w[i] differs.
+size_t LanesSpanEnd(const uint32_t* w, size_t i, size_t limit, uint32_t value) {
+  const hn::ScalableTag<uint32_t> du;
+  const size_t N = hn::Lanes(du);
+  const auto v = hn::Set(du, value);
+  for (; i + N <= limit; i += N) {
+    const auto differs = hn::Ne(hn::LoadU(du, w + i), v);
+    if (!hn::AllFalse(du, differs)) return i + size_t(hn::FindFirstTrue(du, differs));
+  }
+  while (i < limit && w[i] == value) ++i;
+  return i;
+}
+
+// Lanes [used, used + m) of the block from a span of row entries on run
+// r: image positions and view-plane vectors copied from the row's tables
+// (y and vy one value when `constantY`), the tile samples local, local + 1, ….
+void LanesFillSpan(primary_detail::FusedBlock* b, size_t used, size_t m, const double* x, const double* vx,
+                   const double* y, const double* vy, bool constantY, int32_t r, uint32_t local,
+                   uint32_t* localOut) {
+  const hn::ScalableTag<double> d;
+  const hn::RebindToSigned<decltype(d)> di;
+  const hn::Rebind<int32_t, decltype(d)> di32;
+  const hn::Rebind<uint32_t, decltype(d)> du32;
+  const size_t N = hn::Lanes(d);
+  const auto run = hn::Set(di, int64_t(r));
+  const auto run32 = hn::Set(di32, r);
+  size_t k = 0;
+  for (; k + N <= m; k += N) {
+    const size_t o = used + k;
+    hn::StoreU(hn::LoadU(d, x + k), d, b->x + o);
+    hn::StoreU(hn::LoadU(d, vx + k), d, b->vx + o);
+    hn::StoreU(constantY ? hn::Set(d, y[0]) : hn::LoadU(d, y + k), d, b->y + o);
+    hn::StoreU(constantY ? hn::Set(d, vy[0]) : hn::LoadU(d, vy + k), d, b->vy + o);
+    hn::StoreU(run, di, b->run + o);
+    hn::StoreU(run32, di32, b->run32 + o);
+    hn::StoreU(hn::Iota(du32, local + uint32_t(k)), du32, localOut + o);
+  }
+  for (; k < m; ++k) {
+    const size_t o = used + k;
+    b->x[o] = x[k];
+    b->vx[o] = vx[k];
+    b->y[o] = constantY ? y[0] : y[k];
+    b->vy[o] = constantY ? vy[0] : vy[k];
+    b->run[o] = int64_t(r);
+    b->run32[o] = r;
+    localOut[o] = local + uint32_t(k);
   }
 }
 
@@ -104,12 +161,15 @@ HWY_AFTER_NAMESPACE();
 #include <algorithm>
 
 #include "common/primary_refinement.h"
+#include "common/sampling.h"
 #include "common/triangle_plane.h"
 
 namespace rastray {
 
 HWY_EXPORT(SampleLanes);
 HWY_EXPORT(LanesFusedPrimary);
+HWY_EXPORT(LanesSpanEnd);
+HWY_EXPORT(LanesFillSpan);
 
 PrimaryRayConstants::PrimaryRayConstants(const Camera& c)
     : camera(&c),
@@ -152,59 +212,93 @@ PrimaryBatch::~PrimaryBatch() = default;
 
 size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int spp, int x0, int y,
                             const glm::dvec2* grid, uint32_t local0, uint32_t* localOut) {
-  // The view-plane vector of every sample of the row, as the lanes would
-  // compute it (ndcFromImage, then · scale): per column and sample once
-  // per tile, per sample once per row.
+  // Per entry i of the row: the sample's image position (corner + grid
+  // position, as glm adds them: double(x0 + column) is the corner's x
+  // exactly) and its view-plane vector as the lanes would compute it
+  // (ndcFromImage, then · scale); x once per tile, y once per row.
   const size_t columns = n / size_t(spp) + 1;
   if (columnX0_ != x0 || columnSpp_ != spp || columnView_.size() < columns * size_t(spp)) {
     columnX0_ = x0;
     columnSpp_ = spp;
+    columnX_.resize(columns * size_t(spp));
     columnView_.resize(columns * size_t(spp));
     for (size_t c = 0; c < columns; ++c)
       for (int s = 0; s < spp; ++s) {
         const double x = double(x0 + int(c)) + grid[s].x;
+        columnX_[c * size_t(spp) + size_t(s)] = x;
         columnView_[c * size_t(spp) + size_t(s)] = ((2.0 * x) / camera_.width - 1.0) * camera_.scale.x;
       }
   }
-  if (rowY_ != y || rowSpp_ != spp || rowView_.empty()) {
+  if (rowY_ != y || rowSpp_ != spp || rowView_.size() < n) {
     rowY_ = y;
     rowSpp_ = spp;
-    rowView_.resize(size_t(spp));
-    for (int s = 0; s < spp; ++s) {
-      const double yy = double(y) + grid[s].y;
-      rowView_[size_t(s)] = (1.0 - (2.0 * yy) / camera_.height) * camera_.scale.y;
+    // Per sample of a pixel; at several samples, repeated along the row
+    // (at one, the spans below fill the block with the one value).
+    const size_t entries = spp == 1 ? 1 : n;
+    rowYs_.resize(entries);
+    rowView_.resize(entries);
+    double baseY[kMaxGridSide * kMaxGridSide], baseView[kMaxGridSide * kMaxGridSide];
+    for (int k = 0; k < spp; ++k) {
+      baseY[k] = double(y) + grid[k].y;
+      baseView[k] = (1.0 - (2.0 * baseY[k]) / camera_.height) * camera_.scale.y;
     }
+    for (size_t c = 0; c < entries; c += size_t(spp))
+      for (size_t k = 0; k < size_t(spp) && c + k < entries; ++k) {
+        rowYs_[c + k] = baseY[k];
+        rowView_[c + k] = baseView[k];
+      }
   }
+  const double* const columnX = columnX_.data();
   const double* const columnView = columnView_.data();
+  const double* const rowY = rowYs_.data();
   const double* const rowView = rowView_.data();
   // The batch's state in locals (registers) for the loop.
   primary_detail::FusedBlock& b = *block_;
   size_t used = used_, runs = runs_;
   uint32_t last = lastWinner_;
-  const double py = double(y);
   size_t i = first;
-  int s = int(first % size_t(spp));
-  double px = double(x0 + int(first / size_t(spp)));
-  for (; i < n && used < primary_detail::kBlock; ++i) {
+  // A span of entries on one winner: the first 8 looked at here, a
+  // longer one (a large triangle's row, a row of background) in lanes.
+  const auto spanEnd = [winners](size_t from, size_t limit, uint32_t value) {
+    const size_t quick = std::min(limit, from + 8);
+    while (from < quick && winners[from] == value) ++from;
+    return from == quick && from < limit ? HWY_DYNAMIC_DISPATCH(LanesSpanEnd)(winners, from, limit, value)
+                                         : from;
+  };
+  while (i < n && used < primary_detail::kBlock) {
     const uint32_t win = winners[i];
-    if (win != kNoSetup) {
-      if (win != last || runs == 0) {
-        fillRun(runs++, win);
-        last = win;
+    if (win == kNoSetup) {
+      i = spanEnd(i + 1, n, kNoSetup);
+      continue;
+    }
+    if (win != last || runs == 0) {
+      fillRun(runs++, win, used);
+      last = win;
+    }
+    // The span of entries from i on this winner that fits the block:
+    // copied table to block.
+    const size_t end = spanEnd(i + 1, std::min(n, i + (primary_detail::kBlock - used)), win);
+    const size_t m = end - i;
+    const int32_t r = int32_t(runs - 1);
+    const size_t e = spp == 1 ? 0 : i;  // the row tables' entry
+    if (m >= 8) {
+      HWY_DYNAMIC_DISPATCH(LanesFillSpan)
+      (&b, used, m, columnX + i, columnView + i, rowY + e, rowView + e, spp == 1, r, local0 + uint32_t(i),
+       localOut);
+    } else {
+      for (size_t k = 0; k < m; ++k) {
+        const size_t ek = spp == 1 ? 0 : i + k;
+        b.x[used + k] = columnX[i + k];
+        b.y[used + k] = rowY[ek];
+        b.vx[used + k] = columnView[i + k];
+        b.vy[used + k] = rowView[ek];
+        b.run[used + k] = int64_t(r);
+        b.run32[used + k] = r;
+        localOut[used + k] = local0 + uint32_t(i + k);
       }
-      // corner + grid position, as glm adds them
-      b.x[used] = px + grid[s].x;
-      b.y[used] = py + grid[s].y;
-      b.run[used] = int64_t(runs - 1);
-      b.vx[used] = columnView[i];
-      b.vy[used] = rowView[s];
-      localOut[used] = local0 + uint32_t(i);
-      ++used;
     }
-    if (++s == spp) {
-      s = 0;
-      px += 1.0;
-    }
+    used += m;
+    i = end;
   }
   used_ = used;
   runs_ = runs;
@@ -213,7 +307,7 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
 }
 
 // Run r: its setup's planes and its stored triangle's plane.
-void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
+void PrimaryBatch::fillRun(size_t r, uint32_t winner, size_t firstLane) {
   primary_detail::FusedBlock& b = *block_;
   const TriangleSetup& t = setups_[winner];
   runSetup_[r] = &t;
@@ -244,6 +338,7 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
   b.e2DotQ[r] = p.e2DotQ;
   b.slot1[r] = p.slot1;
   b.slot2[r] = p.slot2;
+  runFirst_[r] = uint32_t(firstLane);
   runInstance_[r] = t.instance;
   runTriangle_[r] = t.triangle;
 }
@@ -260,12 +355,6 @@ void PrimaryBatch::run() {
       b.run[k] = int64_t(runs_ - 1);
     }
     HWY_DYNAMIC_DISPATCH(LanesFusedPrimary)(&b, &camera_);
-    for (size_t k = 0; k < used_; ++k) {
-      const bool refined = b.refined[k] != 0.0;
-      kb1_[k] = float(refined ? b.rb1[k] : b.b1[k]);
-      kb2_[k] = float(refined ? b.rb2[k] : b.b2[k]);
-      run32_[k] = int32_t(b.run[k]);
-    }
     return;
   }
   // Orthographic rays: the reference steps, then the batched refinement.
@@ -282,30 +371,32 @@ void PrimaryBatch::run() {
   refinePrimaryHits(scene_, rays, hits, unused, used_, refined);
   for (size_t k = 0; k < used_; ++k) {
     // Exact in double: hit(k) rounds them back to the same floats.
-    b.depth[k] = double(hits[k].depth);
+    b.depth[k] = hits[k].depth;
     b.b1[k] = double(hits[k].b1);
     b.b2[k] = double(hits[k].b2);
     b.dirX[k] = refined[k].direction.x;
     b.dirY[k] = refined[k].direction.y;
     b.dirZ[k] = refined[k].direction.z;
-    kb1_[k] = refined[k].b1;
-    kb2_[k] = refined[k].b2;
-    run32_[k] = int32_t(b.run[k]);
+    b.kb1[k] = refined[k].b1;
+    b.kb2[k] = refined[k].b2;
   }
 }
 
 PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footprintY,
-                                   const uint32_t* colorIndex) const {
+                                   const uint32_t* colorIndex) {
+  runFirst_[runs_] = uint32_t(used_);
   PrimaryHitBlock h;
+  h.runs = runs_;
+  h.runFirst = runFirst_;
   h.count = used_;
-  h.run = run32_;
+  h.run = block_->run32;
   h.runInstance = runInstance_;
   h.runTriangle = runTriangle_;
   h.dirX = block_->dirX;
   h.dirY = block_->dirY;
   h.dirZ = block_->dirZ;
-  h.b1 = kb1_;
-  h.b2 = kb2_;
+  h.b1 = block_->kb1;
+  h.b2 = block_->kb2;
   h.footprintX = footprintX;
   h.footprintY = footprintY;
   h.colorIndex = colorIndex;

@@ -69,7 +69,8 @@ constexpr size_t kBlock = kPrimaryHitBlock;  // a multiple of every target's dou
 struct FusedBlock {
   size_t lanes = 0;
   alignas(64) double x[kBlock], y[kBlock];
-  alignas(64) int64_t run[kBlock];  // non-decreasing within the block
+  alignas(64) int64_t run[kBlock];    // non-decreasing within the block
+  alignas(64) int32_t run32[kBlock];  // the same, for the kernel
   // The view-plane vector (ndc · scale) per lane, when every lane has it
   // (`haveView`: added by addRow from per-tile tables, the operations of
   // the lanes); else the lanes compute it from x and y.
@@ -85,12 +86,16 @@ struct FusedBlock {
   alignas(64) double e1x[kBlock], e1y[kBlock], e1z[kBlock], e2x[kBlock], e2y[kBlock], e2z[kBlock];
   alignas(64) double sx[kBlock], sy[kBlock], sz[kBlock], qx[kBlock], qy[kBlock], qz[kBlock];
   alignas(64) double e2DotQ[kBlock], slot1[kBlock], slot2[kBlock];
-  // Out, per lane: interpolated depth and barycentrics, the ray's
-  // direction, the refined barycentrics and 1 where they replace the
-  // interpolated ones.
-  alignas(64) double depth[kBlock], b1[kBlock], b2[kBlock];
+  // Whether the interpolated barycentrics are wanted (PrimaryBatch::hit);
+  // else the lanes compute them only where the refinement fails.
+  bool wantInterpolated = true;
+  // Out, per lane: the interpolated depth (as a float), the ray's
+  // direction, the barycentrics the kernel shades with (float: the refined
+  // ones where the refinement succeeds, else the interpolated ones) and,
+  // when wanted, the interpolated barycentrics.
+  alignas(64) float depth[kBlock], kb1[kBlock], kb2[kBlock];
   alignas(64) double dirX[kBlock], dirY[kBlock], dirZ[kBlock];
-  alignas(64) double rb1[kBlock], rb2[kBlock], refined[kBlock];
+  alignas(64) double b1[kBlock], b2[kBlock];
 };
 
 }  // namespace primary_detail
@@ -120,10 +125,11 @@ class PrimaryBatch {
     block_->x[k] = x;
     block_->y[k] = y;
     if (winner != lastWinner_ || runs_ == 0) {
-      fillRun(runs_++, winner);
+      fillRun(runs_++, winner, k);
       lastWinner_ = winner;
     }
     block_->run[k] = int64_t(runs_ - 1);
+    block_->run32[k] = int32_t(runs_ - 1);
   }
 
   // Adds the winners of samples [first, n) of one tile row: entry i is
@@ -141,12 +147,16 @@ class PrimaryBatch {
   // The interpolated hit of sample k (primaryShadeHits' `hits`).
   SampleHit hit(size_t k) const {
     const int64_t r = block_->run[k];
-    return {runInstance_[r], runTriangle_[r], float(block_->depth[k]), float(block_->b1[k]),
-            float(block_->b2[k])};
+    return {runInstance_[r], runTriangle_[r], block_->depth[k], float(block_->b1[k]), float(block_->b2[k])};
   }
+  // hit(k).depth alone (hit(k) needs wantInterpolated(true)).
+  float depth(size_t k) const { return block_->depth[k]; }
+  // Whether hit(k) is read (its interpolated barycentrics are computed);
+  // true until set.
+  void wantInterpolated(bool want) { block_->wantInterpolated = want; }
   // The refined hits for the kernel; footprints and colour indices are the
   // caller's (per sample, in the order added).
-  PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex) const;
+  PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex);
   void clear() {
     used_ = 0;
     runs_ = 0;
@@ -154,7 +164,7 @@ class PrimaryBatch {
   }
 
  private:
-  void fillRun(size_t r, uint32_t winner);  // run r's table entry
+  void fillRun(size_t r, uint32_t winner, size_t firstLane);  // run r's table entry
 
   const PrimaryRayConstants& camera_;
   const Scene& scene_;
@@ -165,8 +175,7 @@ class PrimaryBatch {
   const TriangleSetup* runSetup_[primary_detail::kBlock];
   // Per run and per sample, for the kernel (after run()).
   uint32_t runInstance_[primary_detail::kBlock], runTriangle_[primary_detail::kBlock];
-  alignas(64) int32_t run32_[primary_detail::kBlock];
-  alignas(64) float kb1_[primary_detail::kBlock], kb2_[primary_detail::kBlock];
+  uint32_t runFirst_[primary_detail::kBlock + 1];  // each run's first sample, then used_ (hits())
   // The stored triangle's plane as a run needs it (with the eye-dependent
   // terms as intersectTrianglePlane's memo computes them), for recent
   // triangles: a function of the triangle and the eye alone, cached by
@@ -180,11 +189,12 @@ class PrimaryBatch {
   std::unique_ptr<Plane[]> planes_;        // uninitialised where planeKeys_ holds kNoPlane
   std::unique_ptr<uint64_t[]> planeKeys_;  // (instance << 32 | triangle) of each entry
   static constexpr uint64_t kNoPlane = ~uint64_t(0);
-  // addRow's view-plane vectors: per column of the last x0 and sample
-  // (vx), per sample of the last row (vy).
-  std::vector<double> columnView_;
+  // addRow's image positions and view-plane vectors per row entry: x and
+  // vx per column and sample of the last x0, y and vy per entry of the
+  // last row.
+  std::vector<double> columnX_, columnView_;
   int columnX0_ = 0, columnSpp_ = 0;
-  std::vector<double> rowView_;
+  std::vector<double> rowYs_, rowView_;
   int rowY_ = 0, rowSpp_ = 0;
 };
 

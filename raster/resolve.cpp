@@ -1,7 +1,81 @@
+// resolve.h. Highway compiles the lean form's 1-spp row once per SIMD
+// target (foreach_target.h re-includes this file); the rest is host code.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "raster/resolve.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <cstddef>
+#include <cstdint>
+
+#include <hwy/highway.h>
+
 #include "raster/resolve.h"
 
+HWY_BEFORE_NAMESPACE();
+namespace rastray {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// The lean form at 1 spp, one row piece of `width` pixels: a vector of
+// pixels won by one setup (a large triangle's inside) or by none (the
+// background) is written whole; others pixel by pixel. Colour (0 + c) / 1
+// as boxFilter, depth and ids as resolveTileLean's loop for several spp.
+void LanesLeanRow1(const float* color, const float* depthIn, const uint32_t* winners,
+                   const TriangleSetup* setups, size_t width, float* colorOut, float* depthOut,
+                   uint32_t* instanceOut, uint32_t* triangleOut) {
+  const hn::ScalableTag<float> df;
+  const hn::RebindToUnsigned<decltype(df)> du;
+  const size_t N = hn::Lanes(df);
+  const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const SampleHit none;
+  size_t i = 0;
+  for (; i + N <= width; i += N) {
+    const uint32_t first = winners[i];
+    if (!hn::AllTrue(du, hn::Eq(hn::LoadU(du, winners + i), hn::Set(du, first)))) {
+      for (size_t j = i; j < i + N; ++j) {
+        const uint32_t w = winners[j];
+        const bool covered = w != kNoSetup;
+        for (size_t k = 0; k < 4; ++k)
+          colorOut[4 * j + k] = (0.0f + (covered ? color[4 * j + k] : 0.0f)) / 1.0f;
+        depthOut[j] = covered ? depthIn[j] : none.depth;
+        instanceOut[j] = covered ? setups[w].instance : none.instance;
+        triangleOut[j] = covered ? setups[w].triangle : none.triangle;
+      }
+      continue;
+    }
+    if (first == kNoSetup) {
+      for (size_t k = 0; k < 4; ++k)
+        hn::StoreU(hn::Div(hn::Add(zero, zero), one), df, colorOut + 4 * i + k * N);
+      hn::StoreU(hn::Set(df, none.depth), df, depthOut + i);
+      hn::StoreU(hn::Set(du, none.instance), du, instanceOut + i);
+      hn::StoreU(hn::Set(du, none.triangle), du, triangleOut + i);
+      continue;
+    }
+    for (size_t k = 0; k < 4; ++k)
+      hn::StoreU(hn::Div(hn::Add(zero, hn::LoadU(df, color + 4 * i + k * N)), one), df,
+                 colorOut + 4 * i + k * N);
+    hn::StoreU(hn::LoadU(df, depthIn + i), df, depthOut + i);
+    hn::StoreU(hn::Set(du, setups[first].instance), du, instanceOut + i);
+    hn::StoreU(hn::Set(du, setups[first].triangle), du, triangleOut + i);
+  }
+  for (; i < width; ++i) {
+    const uint32_t w = winners[i];
+    const bool covered = w != kNoSetup;
+    for (size_t k = 0; k < 4; ++k) colorOut[4 * i + k] = (0.0f + (covered ? color[4 * i + k] : 0.0f)) / 1.0f;
+    depthOut[i] = covered ? depthIn[i] : none.depth;
+    instanceOut[i] = covered ? setups[w].instance : none.instance;
+    triangleOut[i] = covered ? setups[w].triangle : none.triangle;
+  }
+}
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace rastray
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+
 #include <algorithm>
-#include <cstdint>
 #include <cstring>
 
 #if defined(__SSE2__)
@@ -11,6 +85,8 @@
 #include "common/box_filter.h"
 
 namespace rastray {
+
+HWY_EXPORT(LanesLeanRow1);
 
 namespace {
 
@@ -72,4 +148,60 @@ void resolveTile(const TileRect& rect, int spp, int centreSample, const TileSamp
   streamFence();
 }
 
+void resolveTileLean(const TileRect& rect, int spp, int centreSample, const TileSamples& samples,
+                     const DepthTarget& target, const TriangleSetup* setups, FlatImage* image) {
+  const TileSampleIndex local{rect, spp};
+  glm::vec4 color[kTileSize];
+  float depth[kTileSize];
+  uint32_t instance[kTileSize], triangle[kTileSize];
+  const SampleHit none;
+  // The last winner's ids: consecutive pixels mostly share one.
+  uint32_t last = kNoSetup, lastInstance = none.instance, lastTriangle = none.triangle;
+  for (int y = rect.y0; y < rect.y1; ++y) {
+    for (int x = rect.x0; x < rect.x1; x += kTileSize) {
+      const size_t width = size_t(std::min(rect.x1 - x, kTileSize));
+      const size_t row = local(x, y, 0), first = image->index(x, y);
+      const uint32_t* winners = &target.winners[target.index(x, y, 0)];
+      if (spp == 1) {
+        HWY_DYNAMIC_DISPATCH(LanesLeanRow1)
+        (&samples.color[row].x, samples.depth.data() + row, winners, setups, width, &color[0].x, depth,
+         instance, triangle);
+        streamCopy(image->color.data() + first, color, width * sizeof(glm::vec4));
+        streamCopy(image->depth.data() + first, depth, width * sizeof(float));
+        streamCopy(image->instance.data() + first, instance, width * sizeof(uint32_t));
+        streamCopy(image->triangle.data() + first, triangle, width * sizeof(uint32_t));
+        continue;
+      }
+      // Samples without a winner hold no colour: the full form's 0.
+      boxFilterCovered(samples.color.data() + row, winners, kNoSetup, spp, width, color,
+                       samples.uniformShared);
+      for (size_t i = 0; i < width; ++i) {
+        const size_t c = i * size_t(spp) + size_t(centreSample);
+        const uint32_t w = winners[c];
+        if (w == kNoSetup) {
+          depth[i] = none.depth;
+          instance[i] = none.instance;
+          triangle[i] = none.triangle;
+          continue;
+        }
+        if (w != last) {
+          last = w;
+          lastInstance = setups[w].instance;
+          lastTriangle = setups[w].triangle;
+        }
+        depth[i] = samples.depth[row + c];
+        instance[i] = lastInstance;
+        triangle[i] = lastTriangle;
+      }
+      streamCopy(image->color.data() + first, color, width * sizeof(glm::vec4));
+      streamCopy(image->depth.data() + first, depth, width * sizeof(float));
+      streamCopy(image->instance.data() + first, instance, width * sizeof(uint32_t));
+      streamCopy(image->triangle.data() + first, triangle, width * sizeof(uint32_t));
+    }
+  }
+  streamFence();
+}
+
 }  // namespace rastray
+
+#endif  // HWY_ONCE

@@ -14,6 +14,8 @@
 #include "common/hit.h"
 #include "common/image.h"
 #include "raster/bin.h"
+#include "raster/coverage.h"
+#include "raster/setup.h"
 
 namespace rastray {
 
@@ -37,14 +39,38 @@ struct TileSampleIndex {
   int sample(uint32_t local) const { return int(local % uint32_t(spp)); }
 };
 
-// One tile's final per-sample results, in TileSampleIndex order.
+// One tile's final per-sample results, in TileSampleIndex order, in one
+// of two forms. Full: `color` and `front` for every sample. Lean (`lean`,
+// for a tile whose results are only its pixels: no per-sample hits, deep
+// samples, BLEND layers or trace): `front` is not filled; a sample's ids
+// are its depth-test winner's (the resolve reads them from the depth
+// target), its depth is `depth`, set for every sample with a winner that
+// the resolve reads (the centre sample; the opaque pass sets it from the
+// same float as the full form's front hit); `color` is set only for
+// samples with a winner (the resolve reads the others as the full form's
+// 0). Why: the 20-byte front hit per sample, and the background samples,
+// were written by the winner loop only for the resolve to read them back.
 struct TileSamples {
   std::vector<glm::vec4> color;  // composited, premultiplied
-  std::vector<SampleHit> front;  // nearest visible surface per sample
+  std::vector<SampleHit> front;  // nearest visible surface per sample (full form)
+  std::vector<float> depth;      // the winner's interpolated depth (lean form)
+  bool lean = false;
+  // Lean form, shading once per pixel: a pixel whose samples were all won
+  // by one setup holds its colour in its first sample only (the others
+  // take it: the resolve reads it for them).
+  bool uniformShared = false;
 };
 
+// The full form's resolve.
 void resolveTile(const TileRect& rect, int spp, int centreSample, const TileSamples& samples,
                  FlatImage* image);
+// The lean form's: the same pixels as resolveTile given the full form
+// of the same tile, where front[i] = {setups[w].instance,
+// setups[w].triangle, depth[i]} for a sample won by w, SampleHit{} and
+// colour 0 for a sample without a winner (`target`'s kNoSetup), whatever
+// its entries of `samples` hold.
+void resolveTileLean(const TileRect& rect, int spp, int centreSample, const TileSamples& samples,
+                     const DepthTarget& target, const TriangleSetup* setups, FlatImage* image);
 
 // over(front, back) = front + (1 − front.a)·back (premultiplied, SPEC §4).
 inline glm::vec4 over(const glm::vec4& front, const glm::vec4& back) {

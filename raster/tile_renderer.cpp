@@ -132,6 +132,8 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
       if (reused) s.busy = false;
     }
   } release{scratch, reuse};
+  // The lean form where the tile's results are only its pixels.
+  samples.lean = !out.hits && !out.deep && !traced && !(bins.blend && !bins.blend->empty());
   shadeVisible(index, *target, trace, out.hits != nullptr, samples, n);
   const Clock::time_point t2 = Clock::now();
   std::vector<BlendLayer> layers;
@@ -140,7 +142,10 @@ void TileRenderer::render(const TileRect& rect, const TileBins& bins, DepthTarge
   if (traced) traceLayersAndFinal(index, trace, layers, samples);
   const Clock::time_point t3 = Clock::now();
 
-  resolveTile(rect, grid_.spp, centre_, samples, out.image);
+  if (samples.lean)
+    resolveTileLean(rect, grid_.spp, centre_, samples, *target, setups_.data(), out.image);
+  else
+    resolveTile(rect, grid_.spp, centre_, samples, out.image);
   if (out.hits) copyHits(index, samples, out.hits);
   if (out.deep)
     appendDeepSamples(index, layers, *target, opaqueColor.empty() ? samples.color : opaqueColor, out);

@@ -135,7 +135,8 @@ class TileRenderer {
   // `allFronts`: every sample's front hit is read (per-sample hits out);
   // else only the centre sample's and the traced pixel's need to be set
   // where shading once per pixel reuses a colour.
-  // Fills `samples` (any previous contents are replaced).
+  // Fills `samples` in the form `samples.lean` names (raster/resolve.h);
+  // any previous contents are replaced.
   void shadeVisible(const TileSampleIndex& index, const DepthTarget& target, const TraceRequest& trace,
                     bool allFronts, TileSamples& samples, ThreadCounters& n) const;
 

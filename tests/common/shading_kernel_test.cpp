@@ -368,7 +368,7 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
     // The hits as struct of arrays, their colours to the reversed order.
     const size_t n = hits.size();
     std::vector<int32_t> run(n);
-    std::vector<uint32_t> runInstance, runTriangle, colorIndex(n);
+    std::vector<uint32_t> runInstance, runTriangle, runFirst, colorIndex(n), forward(n);
     std::vector<double> dx(n), dy(n), dz(n), fx(n), fy(n);
     std::vector<float> b1(n), b2(n);
     for (size_t i = 0; i < n; ++i) {
@@ -376,40 +376,55 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
       fx[i] = hits[i].footprintPosition.x, fy[i] = hits[i].footprintPosition.y;
       b1[i] = hits[i].b1, b2[i] = hits[i].b2;
       colorIndex[i] = uint32_t(n - 1 - i);
+      forward[i] = uint32_t(i);
     }
     for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
       SCOPED_TRACE(hwy::TargetName(target));
       hwy::SetSupportedTargetsForTest(target);
-      for (const size_t blockSize : {size_t(1), size_t(7), size_t(kPrimaryHitBlock)}) {
-        PrimaryHitShader kernel(shader, ShadingPath::Kernel);
-        std::vector<glm::vec4> got(n, glm::vec4(-1.0f));
-        for (size_t first = 0; first < n; first += blockSize) {
-          const size_t count = std::min(blockSize, n - first);
-          // Runs within the block: a new one where the triangle changes.
-          runInstance.clear();
-          runTriangle.clear();
-          for (size_t k = 0; k < count; ++k) {
-            const ShadeHit& h = hits[first + k];
-            if (k == 0 || h.instance != runInstance.back() || h.triangle != runTriangle.back()) {
-              runInstance.push_back(h.instance);
-              runTriangle.push_back(h.triangle);
+      // With and without the runs' first hits (runFirst); runs of 16 or
+      // more hits (a wall's row) go to the kernel's block in lanes. With
+      // them, the colours go to consecutive entries (the kernel writes a
+      // block's colours interleaved in lanes then), else to the reversed
+      // order.
+      for (const bool withRunFirst : {false, true})
+        for (const size_t blockSize : {size_t(1), size_t(7), size_t(kPrimaryHitBlock)}) {
+          PrimaryHitShader kernel(shader, ShadingPath::Kernel);
+          std::vector<glm::vec4> got(n, glm::vec4(-1.0f));
+          for (size_t first = 0; first < n; first += blockSize) {
+            const size_t count = std::min(blockSize, n - first);
+            // Runs within the block: a new one where the triangle changes.
+            runInstance.clear();
+            runTriangle.clear();
+            runFirst.clear();
+            for (size_t k = 0; k < count; ++k) {
+              const ShadeHit& h = hits[first + k];
+              if (k == 0 || h.instance != runInstance.back() || h.triangle != runTriangle.back()) {
+                runInstance.push_back(h.instance);
+                runTriangle.push_back(h.triangle);
+                runFirst.push_back(uint32_t(k));
+              }
+              run[first + k] = int32_t(runInstance.size() - 1);
             }
-            run[first + k] = int32_t(runInstance.size() - 1);
+            runFirst.push_back(uint32_t(count));
+            PrimaryHitBlock block;
+            block.count = count;
+            block.run = &run[first];
+            block.runInstance = runInstance.data();
+            block.runTriangle = runTriangle.data();
+            block.dirX = &dx[first], block.dirY = &dy[first], block.dirZ = &dz[first];
+            block.b1 = &b1[first], block.b2 = &b2[first];
+            block.footprintX = &fx[first], block.footprintY = &fy[first];
+            block.colorIndex = withRunFirst ? &forward[first] : &colorIndex[first];
+            if (withRunFirst) {
+              block.runs = runInstance.size();
+              block.runFirst = runFirst.data();
+            }
+            kernel.shade(block, got.data());
           }
-          PrimaryHitBlock block;
-          block.count = count;
-          block.run = &run[first];
-          block.runInstance = runInstance.data();
-          block.runTriangle = runTriangle.data();
-          block.dirX = &dx[first], block.dirY = &dy[first], block.dirZ = &dz[first];
-          block.b1 = &b1[first], block.b2 = &b2[first];
-          block.footprintX = &fx[first], block.footprintY = &fy[first];
-          block.colorIndex = &colorIndex[first];
-          kernel.shade(block, got.data());
+          for (size_t i = 0; i < n; ++i)
+            ASSERT_TRUE(sameBits(got[withRunFirst ? i : colorIndex[i]], expected[i]))
+                << "block " << blockSize << " hit " << i << (withRunFirst ? " run firsts" : "");
         }
-        for (size_t i = 0; i < n; ++i)
-          ASSERT_TRUE(sameBits(got[colorIndex[i]], expected[i])) << "block " << blockSize << " hit " << i;
-      }
     }
     hwy::SetSupportedTargetsForTest(0);
   }

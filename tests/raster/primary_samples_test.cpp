@@ -269,7 +269,8 @@ TEST(PrimarySamples, RowsGiveTheSameBitsAsSamplesOnEveryTarget) {
     for (const std::vector<glm::dvec2>* grid : {&grid1, &grid4}) {
       const int spp = int(grid->size());
       // Tiles of 37 columns from odd offsets, 9 rows each; per row, runs
-      // on one setup, single samples and empty ones.
+      // on one setup, single samples and empty ones; in every third row
+      // long runs (addRow copies spans of 8 or more from its tables).
       struct Row {
         int x0, y;
         std::vector<uint32_t> winners;
@@ -281,6 +282,10 @@ TEST(PrimarySamples, RowsGiveTheSameBitsAsSamplesOnEveryTarget) {
           Row row{x0, y, {}};
           for (int i = 0; i < 37 * spp; ++i) {
             const int kind = (i / 11 + y + t) % 4;
+            if (y % 3 == 0) {
+              row.winners.push_back(i % 29 == 5 ? kNoSetup : uint32_t((i / 23 + y) % setups.size()));
+              continue;
+            }
             row.winners.push_back(kind == 0   ? kNoSetup
                                   : kind == 1 ? uint32_t((i * 7 + y) % setups.size())
                                               : uint32_t((i / 9 + y * 3) % setups.size()));
@@ -304,48 +309,59 @@ TEST(PrimarySamples, RowsGiveTheSameBitsAsSamplesOnEveryTarget) {
       std::vector<ShadeHit> expected(n);
       primaryShadeHits(constants, scene, setups.data(), winners.data(), positions.data(), positions.data(), n,
                        expectedHits.data(), expected.data());
-      for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
-        SCOPED_TRACE(hwy::TargetName(target));
-        hwy::SetSupportedTargetsForTest(target);
-        PrimaryBatch batch(constants, scene, setups.data());
-        uint32_t localOut[kPrimaryHitBlock];
-        size_t next = 0;  // the expected sample the batch's first one is
-        const auto check = [&] {
-          batch.run();
-          const PrimaryHitBlock got = batch.hits(batch.x(), batch.y(), localOut);
-          ASSERT_EQ(got.count, batch.size());
-          for (size_t k = 0; k < got.count; ++k, ++next) {
-            ASSERT_LT(next, n);
-            const ShadeHit& e = expected[next];
-            ASSERT_EQ(localOut[k], locals[next]) << "sample " << next;
-            ASSERT_TRUE(sameBits(batch.hit(k), expectedHits[next])) << "sample " << next;
-            const ShadeHit a{got.runInstance[got.run[k]],
-                             got.runTriangle[got.run[k]],
-                             got.b1[k],
-                             got.b2[k],
-                             {got.dirX[k], got.dirY[k], got.dirZ[k]},
-                             {got.footprintX[k], got.footprintY[k]},
-                             1.0f};
-            ASSERT_TRUE(sameBits(a, e)) << "sample " << next;
-            if (k > 0) {
-              ASSERT_LE(got.run[k - 1], got.run[k]);
+      // wantInterpolated(false), as the lean tile form runs it: the
+      // interpolated barycentrics only where the refinement fails, the
+      // same depth and kernel inputs.
+      for (int64_t target : hwy::SupportedAndGeneratedTargets())
+        for (const bool interpolated : {true, false}) {
+          SCOPED_TRACE(hwy::TargetName(target) + std::string(interpolated ? "" : " lean"));
+          hwy::SetSupportedTargetsForTest(target);
+          PrimaryBatch batch(constants, scene, setups.data());
+          batch.wantInterpolated(interpolated);
+          uint32_t localOut[kPrimaryHitBlock];
+          size_t next = 0;  // the expected sample the batch's first one is
+          const auto check = [&] {
+            batch.run();
+            const PrimaryHitBlock got = batch.hits(batch.x(), batch.y(), localOut);
+            ASSERT_EQ(got.count, batch.size());
+            for (size_t k = 0; k < got.count; ++k, ++next) {
+              ASSERT_LT(next, n);
+              const ShadeHit& e = expected[next];
+              ASSERT_EQ(localOut[k], locals[next]) << "sample " << next;
+              if (interpolated) {
+                ASSERT_TRUE(sameBits(batch.hit(k), expectedHits[next])) << "sample " << next;
+              } else {
+                const float depth = batch.depth(k);
+                ASSERT_EQ(0, std::memcmp(&expectedHits[next].depth, &depth, sizeof(float)))
+                    << "sample " << next;
+              }
+              const ShadeHit a{got.runInstance[got.run[k]],
+                               got.runTriangle[got.run[k]],
+                               got.b1[k],
+                               got.b2[k],
+                               {got.dirX[k], got.dirY[k], got.dirZ[k]},
+                               {got.footprintX[k], got.footprintY[k]},
+                               1.0f};
+              ASSERT_TRUE(sameBits(a, e)) << "sample " << next;
+              if (k > 0) {
+                ASSERT_LE(got.run[k - 1], got.run[k]);
+              }
             }
+            batch.clear();
+          };
+          for (size_t r = 0; r < rows.size(); ++r) {
+            const Row& row = rows[r];
+            for (size_t i = 0; i < row.winners.size();) {
+              i = batch.addRow(row.winners.data(), i, row.winners.size(), spp, row.x0, row.y, grid->data(),
+                               uint32_t(r * 1000), localOut);
+              if (batch.full()) check();
+            }
+            // Every few rows a partial block, as a tile's last one.
+            if (r % 5 == 4 && batch.size() > 0) check();
           }
-          batch.clear();
-        };
-        for (size_t r = 0; r < rows.size(); ++r) {
-          const Row& row = rows[r];
-          for (size_t i = 0; i < row.winners.size();) {
-            i = batch.addRow(row.winners.data(), i, row.winners.size(), spp, row.x0, row.y, grid->data(),
-                             uint32_t(r * 1000), localOut);
-            if (batch.full()) check();
-          }
-          // Every few rows a partial block, as a tile's last one.
-          if (r % 5 == 4 && batch.size() > 0) check();
+          if (batch.size() > 0) check();
+          EXPECT_EQ(next, n);
         }
-        if (batch.size() > 0) check();
-        EXPECT_EQ(next, n);
-      }
       hwy::SetSupportedTargetsForTest(0);
     }
   }

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <random>
+#include <string>
 
 #include "common/gltf/loader.h"
 #include "common/sampling.h"
@@ -247,4 +249,39 @@ TEST(Textures, MipLevelGrowsTowardsTheHorizonOnTheGrazingPlane) {
 
 }  // namespace
 
+}  // namespace rastray
+
+namespace rastray {
+namespace {
+
+// A tile whose results are only its pixels takes the lean form
+// (raster/resolve.h: no front hits, no background samples written; at
+// shading rate pixel, pixels won by one setup alone take a path of their
+// own): the same picture, depth and ids as the full form, which per-sample
+// hits ask for. The Cornell box in perspective (depth varies along every
+// wall; background at the open side), at every rate and at sample counts
+// whose centre sample is the first and, at 25 (a 5 × 5 grid), is not.
+TEST(LeanTiles, GiveTheFullFormsPicturesAtEveryRate) {
+  const Scene scene = loadScene(scenePath("cornell-box.gltf"));
+  const Camera camera = sceneCamera(scene, 97, 61);
+  for (const int spp : {1, 2, 4, 25})
+    for (const ShadingRate rate : {ShadingRate::Sample, ShadingRate::Pixel}) {
+      SCOPED_TRACE("spp " + std::to_string(spp) + (rate == ShadingRate::Pixel ? " pixel" : " sample"));
+      RasterOptions o;
+      o.spp = spp;
+      o.shadingRate = rate;
+      o.shadows = RasterShadows::None;
+      const RenderOutput lean = render(scene, camera, o);
+      std::vector<SampleHit> hits;
+      const RenderOutput full = renderRasterWithHits(scene, analyzeScene(scene), camera, o, &hits);
+      const FlatImage &a = lean.image, &b = full.image;
+      EXPECT_EQ(0, std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(glm::vec4)));
+      EXPECT_EQ(0, std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)));
+      EXPECT_EQ(a.instance, b.instance);
+      EXPECT_EQ(a.triangle, b.triangle);
+      EXPECT_GT(std::count(a.instance.begin(), a.instance.end(), kNoId), 0);
+    }
+}
+
+}  // namespace
 }  // namespace rastray
