@@ -24,6 +24,12 @@ const char* toString(RayKind kind) {
   return "?";
 }
 
+void LightVisibility::transmittances(int lightIndex, size_t n, const SurfacePoint* const* points,
+                                     const glm::dvec3* toLight, const double* distance,
+                                     glm::vec3* out) const {
+  for (size_t k = 0; k < n; ++k) out[k] = transmittance(*points[k], lightIndex, toLight[k], distance[k]);
+}
+
 Shader::Shader(const Scene& scene, const SceneAnalysis& analysis, const Camera& camera,
                const ShadingOptions& options, const LightVisibility* visibility,
                const SecondaryRayTracer* secondary)

@@ -66,6 +66,14 @@ class LightVisibility {
   // directional lights).
   virtual glm::vec3 transmittance(const SurfacePoint& point, int lightIndex, const glm::dvec3& toLight,
                                   double distance) const = 0;
+  // The same for n points of one light: out[k] = transmittance(*points[k],
+  // lightIndex, toLight[k], distance[k]), bit for bit, each as if asked
+  // alone (whatever else is in the batch), asked in order k = 0, 1, ….
+  // The shading kernel calls it once per light with the lanes it lights.
+  // This default asks one at a time; the ray caster traces the first
+  // occlusion query of up to 16 rays as one packet (rtcOccluded16).
+  virtual void transmittances(int lightIndex, size_t n, const SurfacePoint* const* points,
+                              const glm::dvec3* toLight, const double* distance, glm::vec3* out) const;
 };
 
 // Radiance along secondary rays: implemented by the ray caster, and used by

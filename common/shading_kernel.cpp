@@ -659,23 +659,29 @@ class BlockShader {
         }
         HWY_DYNAMIC_DISPATCH(LanesLightWeight)(&b, lights_[l]);
         if (visibility) {
+          // The lit lanes, asked in one batch (the ray caster traces them
+          // in packets): Shader::directLight's direction and distance, in
+          // double.
+          size_t n = 0;
           for (size_t i = 0; i < b.used; ++i) {
             if (!(b.weight[i] > 0.0f)) continue;
-            // Shader::directLight's direction and distance, in double.
-            glm::dvec3 toLight;
-            double distance;
             if (light.type == LightType::Directional) {
-              toLight = -light.direction;
-              distance = std::numeric_limits<double>::infinity();
+              litToLight_[n] = -light.direction;
+              litDistance_[n] = std::numeric_limits<double>::infinity();
             } else {
               const glm::dvec3 v = light.position - points_[i].position;
-              distance = glm::length(v);
-              toLight = v / distance;
+              litDistance_[n] = glm::length(v);
+              litToLight_[n] = v / litDistance_[n];
             }
-            const glm::vec3 v = visibility->transmittance(points_[i], int(l), toLight, distance);
-            b.visR[i] = v.r;
-            b.visG[i] = v.g;
-            b.visB[i] = v.b;
+            litPoints_[n] = &points_[i];
+            litLanes_[n++] = uint32_t(i);
+          }
+          visibility->transmittances(int(l), n, litPoints_, litToLight_, litDistance_, litVisibility_);
+          for (size_t k = 0; k < n; ++k) {
+            const size_t i = litLanes_[k];
+            b.visR[i] = litVisibility_[k].r;
+            b.visG[i] = litVisibility_[k].g;
+            b.visB[i] = litVisibility_[k].b;
           }
         }
         HWY_DYNAMIC_DISPATCH(LanesAccumulate)(&b, lights_[l], visibility != nullptr);
@@ -827,6 +833,12 @@ class BlockShader {
   glm::vec4* outputs_[kBlock];
   bool contiguous_ = true;       // outputs_[i] == outputs_[0] + i for every used lane
   SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback
+  // One light's lit lanes, for LightVisibility::transmittances.
+  const SurfacePoint* litPoints_[kBlock];
+  glm::dvec3 litToLight_[kBlock];
+  double litDistance_[kBlock];
+  glm::vec3 litVisibility_[kBlock];
+  uint32_t litLanes_[kBlock];
 };
 
 }  // namespace

@@ -239,7 +239,7 @@ struct Avx2Row {
       const __m256i stored = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row));
       const __m256i p = _mm256_cmpgt_epi32(stored, k);
       passes |= uint64_t(uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(p)))) << (8 * j);
-      const __m256i n = _mm256_blendv_epi8(stored, k, p);
+      const __m256i n = _mm256_min_epi32(stored, k);  // k where it passes (k < stored), else stored
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(row), n);
       acc = _mm256_max_epi32(acc, n);
     }
@@ -247,6 +247,46 @@ struct Avx2Row {
     return uint32_t(bitCount(passes));
   }
 };
+
+// Avx2Row with whole covered blocks in AVX-512 (F, VL): a row's eight
+// doubles in one vector, converted to eight floats by one VCVTPD2PS (the
+// AVX2 form takes two and an insert), the pass mask from a mask compare.
+// The same operations per lane in the same operand order (VMAXPD/VMINPD
+// return their second operand when unordered or equal at every width;
+// the conversion rounds by MXCSR as the others do), so the same bits.
+// target() enables FMA with AVX-512F, but -ffp-contract=off (every source)
+// keeps the additions and products apart.
+// GCC 12's AVX-512 intrinsics pass _mm512_undefined_pd() as the unused
+// merge operand, which -Wmaybe-uninitialized reports: a false positive.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+struct Avx512Row : Avx2Row {
+  __attribute__((target("avx2,avx512f,avx512vl"))) static uint32_t fullBlock(bool reversed,
+                                                                             const double (&column)[8],
+                                                                             const Plane& plane, int by,
+                                                                             double offsetY, int32_t* row,
+                                                                             int32_t* maxKey) {
+    const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1.0);
+    const __m512d c = _mm512_loadu_pd(column);
+    const __m256i keyBase = _mm256_set1_epi32(int32_t(0xBF800000u)), bias = _mm256_set1_epi32(int32_t(kBias));
+    __m256i acc = _mm256_set1_epi32(INT32_MIN);
+    uint64_t passes = 0;  // bit 8j + i: texel i of row j written
+    for (int j = 0; j < B; ++j, row += kTileSize) {
+      const __m512d r = _mm512_set1_pd(planeRowTerm(plane, by + j, offsetY));
+      const __m256i bits =
+          _mm256_castps_si256(_mm512_cvtpd_ps(_mm512_min_pd(one, _mm512_max_pd(zero, _mm512_add_pd(c, r)))));
+      const __m256i k = reversed ? _mm256_sub_epi32(keyBase, bits) : _mm256_xor_si256(bits, bias);
+      const __m256i stored = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row));
+      passes |= uint64_t(_mm256_cmpgt_epi32_mask(stored, k)) << (8 * j);
+      const __m256i n = _mm256_min_epi32(stored, k);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(row), n);
+      acc = _mm256_max_epi32(acc, n);
+    }
+    *maxKey = reduce(acc);
+    return uint32_t(bitCount(passes));
+  }
+};
+#pragma GCC diagnostic pop
 #endif
 
 // drawFast<Avx2Row> passes AVX vectors between functions compiled without
@@ -386,6 +426,21 @@ bool hasAvx2() {
   return yes;
 }
 
+__attribute__((target("avx2,avx512f,avx512vl"))) void drawAvx512(int32_t* keys, const TileRect& rect,
+                                                                 const std::vector<TriangleSetup>& setups,
+                                                                 const std::vector<uint32_t>& bin,
+                                                                 const SampleGrid& grid, DepthFormat format,
+                                                                 const AlphaTestFunction& alphaTest,
+                                                                 DepthPassCounters* counters) {
+  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Avx512Row{});
+}
+
+bool hasAvx512() {
+  static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("avx512f") &&
+                          __builtin_cpu_supports("avx512vl");
+  return yes;
+}
+
 // The tile buffer's clear and its rows' streaming out, 32 bytes a store
 // (a 2048² cube map clears and writes 100 MB a frame; 16-byte stores were
 // about a tenth of the map pass).
@@ -517,7 +572,11 @@ void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::
     return;
   }
 #if defined(RASTRAY_DEPTH_ONLY_AVX2)
-  if (simd == SimdLevel::Best && hasAvx2()) {
+  if (simd == SimdLevel::Best && hasAvx512()) {
+    drawAvx512(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+    return;
+  }
+  if (simd != SimdLevel::Baseline && hasAvx2()) {
     drawAvx2(keys_, rect, setups, bin, grid, format, alphaTest, counters);
     return;
   }

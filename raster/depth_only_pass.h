@@ -69,10 +69,12 @@ struct DepthMap {
 
 using AlphaTestFunction = std::function<bool(const TriangleSetup&, int px, int py, int s)>;
 
-// The fast path's vector width: Best picks AVX2 at run time where the CPU
-// has it, Baseline keeps to SSE2 (x86-64's baseline). Identical keys; the
-// choice is there for the tests that prove it.
-enum class SimdLevel { Best, Baseline };
+// The fast path's vector width: Best picks, at run time, AVX-512 (F and
+// VL: whole covered blocks a row of eight doubles per vector) where the
+// CPU has it, else AVX2; Avx2 stops at AVX2; Baseline keeps to SSE2
+// (x86-64's baseline). Identical keys; the choice is there for the tests
+// that prove it.
+enum class SimdLevel { Best, Avx2, Baseline };
 
 // One tile of the pass, drawn into its local buffer.
 class DepthOnlyTile {

@@ -4,6 +4,7 @@
 // Shader's SecondaryRayTracer and LightVisibility for more rays, which
 // come back here (traceRadiance, traceTransmittance) with the same
 // context, one depth further.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -62,19 +63,26 @@ glm::vec3 traceRadiance(const CasterState& state, const RayTreeContext& context,
   return glm::vec3(shadeRay(state, context, kind, depth, throughput, g, crossings, DeepTarget{}).color);
 }
 
-glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& context,
-                             const SurfacePoint& point, const glm::dvec3& toLight, double distance) {
-  context.count(RayKind::Shadow);
-  const glm::dvec3 dir = glm::normalize(toLight);
-  const RayScratch::Use use(*context.scratch);
-  HitGather& g = use.level().gather;
+namespace {
+
+// A shadow ray's first query from `point` towards unit `dir`: g set up
+// for it (mode, ray from the offset origin); returns the origin, and its
+// offset side in *side.
+glm::vec3 startShadowRay(const CasterState& state, const SurfacePoint& point, const glm::dvec3& dir,
+                         double distance, HitGather& g, glm::dvec3* side) {
   g.mode = GatherMode::Shadow;
   g.primary = false;
-  glm::dvec3 side;
-  glm::vec3 origin = secondaryRayOrigin(state, point, dir, &side);
+  const glm::vec3 origin = secondaryRayOrigin(state, point, dir, side);
   g.ray = secondaryRay(origin, dir, distance);
   g.hits.clear();
-  bool blocked = traceOcclusion(state, g);
+  return origin;
+}
+
+// The rest of traceTransmittance once its first occlusion query has
+// answered `blocked` (g as traceOcclusion left it).
+glm::vec3 finishTransmittance(const CasterState& state, const RayTreeContext& context,
+                              const SurfacePoint& point, const glm::dvec3& dir, double distance,
+                              glm::vec3 origin, const glm::dvec3& side, HitGather& g, bool blocked) {
   // Blocked: by a seam neighbour the ray leaves (ray_offset.h, "Concave
   // seams")? The first hit says; then off its plane too, and again.
   FloatTriangle planes[4] = {floatTriangle(state.scene, point.instance, point.triangle)};
@@ -103,6 +111,51 @@ glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& con
     context.recorder->finish(record, blocked ? 0 : int(g.hits.size()), glm::vec4(result, 1.0f));
   }
   return result;
+}
+
+}  // namespace
+
+glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& context,
+                             const SurfacePoint& point, const glm::dvec3& toLight, double distance) {
+  context.count(RayKind::Shadow);
+  const glm::dvec3 dir = glm::normalize(toLight);
+  const RayScratch::Use use(*context.scratch);
+  HitGather& g = use.level().gather;
+  glm::dvec3 side;
+  const glm::vec3 origin = startShadowRay(state, point, dir, distance, g, &side);
+  const bool blocked = traceOcclusion(state, g);
+  return finishTransmittance(state, context, point, dir, distance, origin, side, g, blocked);
+}
+
+void traceTransmittances(const CasterState& state, const RayTreeContext& context, size_t n,
+                         const SurfacePoint* const* points, const glm::dvec3* toLight, const double* distance,
+                         glm::vec3* out, bool packets) {
+  if (context.recorder || !packets) {
+    for (size_t k = 0; k < n; ++k)
+      out[k] = traceTransmittance(state, context, *points[k], toLight[k], distance[k]);
+    return;
+  }
+  HitGather* gathers = context.scratch->packet.data();
+  glm::dvec3 dirs[kShadowPacket], sides[kShadowPacket];
+  glm::vec3 origins[kShadowPacket];
+  bool blocked[kShadowPacket];
+  for (size_t first = 0; first < n; first += kShadowPacket) {
+    const size_t m = std::min(kShadowPacket, n - first);
+    if (m == 1) {  // a packet of one: the single-ray query
+      out[first] = traceTransmittance(state, context, *points[first], toLight[first], distance[first]);
+      break;
+    }
+    for (size_t k = 0; k < m; ++k) {
+      context.count(RayKind::Shadow);
+      dirs[k] = glm::normalize(toLight[first + k]);
+      origins[k] =
+          startShadowRay(state, *points[first + k], dirs[k], distance[first + k], gathers[k], &sides[k]);
+    }
+    traceOcclusionPacket(state, gathers, m, blocked);
+    for (size_t k = 0; k < m; ++k)
+      out[first + k] = finishTransmittance(state, context, *points[first + k], dirs[k], distance[first + k],
+                                           origins[k], sides[k], gathers[k], blocked[k]);
+  }
 }
 
 namespace {

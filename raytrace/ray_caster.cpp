@@ -68,6 +68,10 @@ class TracedRayTree : public SecondaryRayTracer, public LightVisibility {
                           double distance) const override {
     return traceTransmittance(state_, context(), point, toLight, distance);
   }
+  void transmittances(int /*lightIndex*/, size_t n, const SurfacePoint* const* points,
+                      const glm::dvec3* toLight, const double* distance, glm::vec3* out) const override {
+    traceTransmittances(state_, context(), n, points, toLight, distance, out, state_.options.shadowPackets);
+  }
 
  private:
   const CasterState& state_;
@@ -208,6 +212,13 @@ glm::vec3 RayCaster::transmittance(const SurfacePoint& point, int /*lightIndex*/
                                    double distance) const {
   RASTRAY_CHECK(impl_->bound, "RayCaster::transmittance before bind");
   return traceTransmittance(*impl_, untracedContext(*impl_), point, toLight, distance);
+}
+
+void RayCaster::transmittances(int /*lightIndex*/, size_t n, const SurfacePoint* const* points,
+                               const glm::dvec3* toLight, const double* distance, glm::vec3* out) const {
+  RASTRAY_CHECK(impl_->bound, "RayCaster::transmittances before bind");
+  traceTransmittances(*impl_, untracedContext(*impl_), n, points, toLight, distance, out,
+                      impl_->options.shadowPackets);
 }
 
 void RayCaster::resetCounters() {

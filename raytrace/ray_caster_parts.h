@@ -50,6 +50,9 @@ namespace rastray {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+// Rays per shadow-ray packet (rtcOccluded16).
+constexpr size_t kShadowPacket = 16;
+
 // Rays traced, by RayKind.
 using RayCounts = std::array<uint64_t, kRayKindCount>;
 
@@ -127,6 +130,12 @@ class RayScratch {
   }
   std::vector<std::unique_ptr<Level>> levels_;
   size_t top_ = 0;
+
+ public:
+  // One gather per lane of a shadow-ray packet (traceTransmittances). A
+  // batch of shadow rays spawns no batch of its own (its lanes' seam
+  // loops trace single rays), so one set serves the thread.
+  std::array<HitGather, kShadowPacket> packet;
 };
 
 // What each thread tracing rays keeps: its counts since bind() and its
@@ -287,6 +296,13 @@ GatheredHit intersectClosest(const CasterState& state, HitGather& g, bool cohere
 // triangle).
 bool traceOcclusion(const CasterState& state, HitGather& g);
 
+// traceOcclusion for n ≤ kShadowPacket rays at once, gathers[k].ray the
+// kth (its ray id k), as one rtcOccluded16 packet: blocked[k] and
+// gathers[k].hits as traceOcclusion(state, gathers[k]) leaves them (the
+// tests demand it on every shadow ray of the bundled scenes: Embree's
+// packet and single-ray triangle tests are separate code).
+void traceOcclusionPacket(const CasterState& state, HitGather* gathers, size_t n, bool* blocked);
+
 // The surfaces along a traced ray, front to back: the gathered BLEND hits
 // in front of `closest` (the stopping hit, or none), one per crossing, then
 // the stopping one; ordered by (plane t, instance, triangle) and cut after
@@ -323,6 +339,14 @@ glm::vec3 traceRadiance(const CasterState& state, const RayTreeContext& context,
                         const glm::dvec3& direction, RayKind kind, int depth, float throughput);
 glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& context,
                              const SurfacePoint& point, const glm::dvec3& toLight, double distance);
+// LightVisibility::transmittances: traceTransmittance of each point, the
+// first occlusion query of up to kShadowPacket of them in one packet
+// (traceOcclusionPacket), the rest of each (a seam's retries) as
+// traceTransmittance continues. A recorded tree (context.recorder) or
+// `packets` false traces them one by one.
+void traceTransmittances(const CasterState& state, const RayTreeContext& context, size_t n,
+                         const SurfacePoint* const* points, const glm::dvec3* toLight, const double* distance,
+                         glm::vec3* out, bool packets = true);
 
 // --- primary visibility (primary_visibility.cpp) ------------------------------
 

@@ -137,6 +137,44 @@ bool traceOcclusion(const CasterState& state, HitGather& g) {
   return false;
 }
 
+void traceOcclusionPacket(const CasterState& state, HitGather* gathers, size_t n, bool* blocked) {
+  static_assert(kShadowPacket == 16, "one RTCRay16 per packet");
+  alignas(64) int valid[16];
+  alignas(64) RTCRay16 ray;
+  for (size_t i = 0; i < 16; ++i) {
+    // Lanes without a ray: invalid, and a harmless ray should Embree read them.
+    const bool used = i < n;
+    // traceOcclusion's float ray (makeRayHit's fields), lane by lane.
+    const glm::vec3 o = used ? glm::vec3(gathers[i].ray.origin) : glm::vec3(0.0f);
+    const glm::vec3 d = used ? glm::vec3(gathers[i].ray.direction) : glm::vec3(0.0f, 0.0f, -1.0f);
+    valid[i] = used ? -1 : 0;
+    ray.org_x[i] = o.x;
+    ray.org_y[i] = o.y;
+    ray.org_z[i] = o.z;
+    ray.tnear[i] = used ? float(gathers[i].ray.tNear) : 0.0f;
+    ray.dir_x[i] = d.x;
+    ray.dir_y[i] = d.y;
+    ray.dir_z[i] = d.z;
+    ray.time[i] = 0.0f;
+    ray.tfar[i] = used ? float(gathers[i].ray.tFar) : -kInf;
+    ray.mask[i] = 0xFFFFFFFFu;
+    ray.id[i] = unsigned(i);
+    ray.flags[i] = 0;
+  }
+  GatherContext context;
+  rtcInitIntersectContext(&context.embree);
+  context.gathers = gathers;
+  {
+    FlushDenormalsScope ftz;
+    rtcOccluded16(valid, state.embree->handle(), &context.embree, &ray);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    blocked[i] = ray.tfar[i] == -kInf;
+    if (!blocked[i] && !gathers[i].hits.empty())
+      sortAndMergeCrossings(state.scene, gathers[i].ray, &gathers[i].hits);
+  }
+}
+
 namespace {
 
 RTCRayHit makeRayHit(const glm::vec3& origin, const glm::vec3& direction, float tnear, float tfar,

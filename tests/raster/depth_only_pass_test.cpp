@@ -208,12 +208,16 @@ void expectSameMaps(const std::vector<TriangleSetup>& setups, const SampleGrid& 
     const AlphaTestFunction& a = alpha ? *alpha : none;
     const std::string label = what + (alpha ? " with alpha test" : "");
     const Maps fast = depthOnly(setups, grid, w, h, format, a, CoveragePath::Fast);
+    const Maps avx2 = depthOnly(setups, grid, w, h, format, a, CoveragePath::Fast, SimdLevel::Avx2);
     const Maps baseline = depthOnly(setups, grid, w, h, format, a, CoveragePath::Fast, SimdLevel::Baseline);
     const Maps slow = depthOnly(setups, grid, w, h, format, a, CoveragePath::Reference);
     const Maps before = keysOnlyDepthPass(setups, grid, w, h, format, a, CoveragePath::Fast);
     const Maps beforeSlow = keysOnlyDepthPass(setups, grid, w, h, format, a, CoveragePath::Reference);
     ASSERT_EQ(fast.keys, slow.keys) << label;
+    ASSERT_EQ(avx2.keys, slow.keys) << label;
     ASSERT_EQ(baseline.keys, slow.keys) << label;
+    EXPECT_EQ(avx2.counters.samplesTested, fast.counters.samplesTested) << label;
+    EXPECT_EQ(avx2.counters.samplesPassed, fast.counters.samplesPassed) << label;
     EXPECT_EQ(baseline.counters.samplesTested, fast.counters.samplesTested) << label;
     EXPECT_EQ(baseline.counters.samplesPassed, fast.counters.samplesPassed) << label;
     ASSERT_EQ(fast.keys, before.keys) << label;
