@@ -135,10 +135,12 @@ void primarySamplesReference(const PrimaryRayConstants& camera, const TriangleSe
   }
 }
 
-PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups)
+PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
+                           const RefinePlane* planes)
     : camera_(camera),
       scene_(scene),
       setups_(setups),
+      refinePlanes_(planes),
       // Not value-initialised (about 30 KB a tile): every lane and run
       // entry is written before it is read.
       block_(new primary_detail::FusedBlock),
@@ -222,6 +224,20 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
   b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
   b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
   b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
+  runInstance_[r] = t.instance;
+  runTriangle_[r] = t.triangle;
+  if (refinePlanes_) {
+    // Computed in setup (raster/setup.h: RefinePlane).
+    const RefinePlane& p = refinePlanes_[winner];
+    b.e1x[r] = p.e1.x, b.e1y[r] = p.e1.y, b.e1z[r] = p.e1.z;
+    b.e2x[r] = p.e2.x, b.e2y[r] = p.e2.y, b.e2z[r] = p.e2.z;
+    b.sx[r] = p.s.x, b.sy[r] = p.s.y, b.sz[r] = p.s.z;
+    b.qx[r] = p.q.x, b.qy[r] = p.q.y, b.qz[r] = p.q.z;
+    b.e2DotQ[r] = p.e2DotQ;
+    b.slot1[r] = double(p.slot1);
+    b.slot2[r] = double(p.slot2);
+    return;
+  }
   const size_t slot = (t.triangle * 2654435761u + t.instance * 40503u) >> (32 - kPlaneCacheBits);
   Plane& p = planes_[slot];
   const uint64_t key = t.id();
@@ -244,8 +260,6 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner) {
   b.e2DotQ[r] = p.e2DotQ;
   b.slot1[r] = p.slot1;
   b.slot2[r] = p.slot2;
-  runInstance_[r] = t.instance;
-  runTriangle_[r] = t.triangle;
 }
 
 void PrimaryBatch::run() {

@@ -102,7 +102,11 @@ struct FusedBlock {
 // bits as primaryShadeHits, which runs through it.
 class PrimaryBatch {
  public:
-  PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups);
+  // `planes`, when given, holds each setup's stored-triangle plane for
+  // camera.eye (prepareTriangles' RefinePlaneRequest; the same bits as
+  // computing it here), read instead of computed.
+  PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
+               const RefinePlane* planes = nullptr);
   ~PrimaryBatch();
   PrimaryBatch(const PrimaryBatch&) = delete;
   PrimaryBatch& operator=(const PrimaryBatch&) = delete;
@@ -159,6 +163,7 @@ class PrimaryBatch {
   const PrimaryRayConstants& camera_;
   const Scene& scene_;
   const TriangleSetup* setups_;
+  const RefinePlane* refinePlanes_;
   std::unique_ptr<primary_detail::FusedBlock> block_;
   size_t used_ = 0, runs_ = 0;
   uint32_t lastWinner_ = 0;

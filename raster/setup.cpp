@@ -252,6 +252,7 @@ struct SetupChunk {
 struct ChunkOutput {
   uint32_t inputs = 0;  // the chunk's triangles
   std::vector<TriangleSetup> setups;
+  std::vector<RefinePlane> planes;  // one per setup, when asked (RefinePlaneRequest)
   SetupCounters counters;
 };
 
@@ -487,6 +488,27 @@ void computeVertexCodes(const Scene& scene, const ClipSpace& space, const Sample
   });
 }
 
+// `*v` emptied, with capacity for n elements: fresh storage is advised
+// to use huge pages; reused storage was advised when it was made.
+template <typename T>
+void reserveReused(size_t n, std::vector<T>* v) {
+  v->clear();
+  if (v->capacity() >= n) return;
+  std::vector<T>().swap(*v);
+  v->reserve(n);
+  adviseHugePages(v->data(), v->capacity() * sizeof(T));
+}
+
+// A chunk's refinement planes (all its setups lie on one instance), in
+// lanes while its corners are in cache.
+void chunkPlanes(const Scene& scene, uint32_t instance, const glm::dvec3& eye, ChunkOutput* out) {
+  thread_local std::vector<uint32_t> triangles;
+  triangles.resize(out->setups.size());
+  for (size_t i = 0; i < out->setups.size(); ++i) triangles[i] = out->setups[i].triangle;
+  out->planes.resize(out->setups.size());
+  refinePlanes(scene, instance, triangles.data(), triangles.size(), eye, out->planes.data());
+}
+
 }  // namespace
 
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
@@ -499,7 +521,8 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
 
 void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
                       const DepthSettings& depth, CullMode cull, TriangleFilter filter,
-                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* storage) {
+                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* storage,
+                      RefinePlaneRequest refine) {
   // Chunks of one instance's triangles, set up in parallel and appended in
   // chunk order by a pipeline: deterministic whatever the scheduling, and
   // only the chunks in flight (a few per thread) exist besides the result,
@@ -524,13 +547,8 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
   // capacity is reserved once, and pages the setups never reach are never
   // touched (so they cost address space, not memory).
   std::vector<TriangleSetup>& setups = *storage;
-  setups.clear();
-  if (setups.capacity() < inputs) {
-    // Fresh storage (reused storage was advised when it was made).
-    std::vector<TriangleSetup>().swap(setups);
-    setups.reserve(inputs);
-    adviseHugePages(setups.data(), setups.capacity() * sizeof(TriangleSetup));
-  }
+  reserveReused(inputs, &setups);
+  if (refine.planes) reserveReused(inputs, refine.planes);
   size_t next = 0, appendedInputs = 0;
   const size_t tokens = 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
   // A chunk's output waits in its slot from the parallel stage to the ordered
@@ -558,6 +576,7 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
       setupChunkFast(context, codes, chunks[c], out.get());
     else
       setupChunkReference(context, chunks[c], out.get());
+    if (refine.planes) chunkPlanes(scene, chunks[c].instance, refine.eye, out.get());
     outputs[c] = std::move(out);
     tsanRelease(&outputs[c]);
     return c;
@@ -570,9 +589,13 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
     appendedInputs += out->inputs;
     // Clipping made more pieces than the reserve foresaw: grow
     // once by what the remaining inputs can still need.
-    if (setups.size() + out->setups.size() > setups.capacity())
-      setups.reserve(setups.size() + out->setups.size() + (inputs - std::min(inputs, appendedInputs)));
+    if (setups.size() + out->setups.size() > setups.capacity()) {
+      const size_t need = setups.size() + out->setups.size() + (inputs - std::min(inputs, appendedInputs));
+      setups.reserve(need);
+      if (refine.planes) refine.planes->reserve(need);
+    }
     setups.insert(setups.end(), out->setups.begin(), out->setups.end());
+    if (refine.planes) refine.planes->insert(refine.planes->end(), out->planes.begin(), out->planes.end());
     add(out->counters, counters);
     tsanRelease(&setups);
   };
