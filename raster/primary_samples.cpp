@@ -191,6 +191,11 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
     const uint32_t win = winners[i];
     if (win != kNoSetup) {
       if (win != last || runs == 0) {
+        // Small triangles make runs of one or two samples, each on a setup
+        // (and its refinement plane) mostly not in cache: the one a few
+        // samples on is fetched now.
+        if (i + kRunPrefetch < n && winners[i + kRunPrefetch] != kNoSetup)
+          prefetchRun(winners[i + kRunPrefetch]);
         fillRun(runs++, win);
         last = win;
       }
@@ -212,6 +217,20 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
   runs_ = runs;
   lastWinner_ = last;
   return i;
+}
+
+void PrimaryBatch::prefetchRun(uint32_t winner) const {
+  // The bytes fillRun reads: the setup's ids and planes, the refinement plane.
+  const char* t = reinterpret_cast<const char*>(&setups_[winner]);
+  __builtin_prefetch(t);
+  __builtin_prefetch(t + offsetof(TriangleSetup, depth));
+  __builtin_prefetch(t + offsetof(TriangleSetup, dOverW));
+  __builtin_prefetch(t + offsetof(TriangleSetup, b2OverW) + sizeof(PlaneCoefficients) - 1);
+  if (refinePlanes_) {
+    const char* p = reinterpret_cast<const char*>(&refinePlanes_[winner]);
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + sizeof(RefinePlane) - 1);
+  }
 }
 
 // Run r: its setup's planes and its stored triangle's plane.

@@ -158,7 +158,9 @@ class PrimaryBatch {
   }
 
  private:
-  void fillRun(size_t r, uint32_t winner);  // run r's table entry
+  void fillRun(size_t r, uint32_t winner);   // run r's table entry
+  void prefetchRun(uint32_t winner) const;   // what fillRun will read for it
+  static constexpr size_t kRunPrefetch = 8;  // samples ahead in addRow
 
   const PrimaryRayConstants& camera_;
   const Scene& scene_;
