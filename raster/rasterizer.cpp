@@ -113,7 +113,7 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   // The camera pass's refinement planes (raster/setup.h: RefinePlane),
   // computed in lanes while setup has the corners in cache. A perspective
   // camera only: the orthographic path refines with the scalar steps.
-  std::vector<RefinePlane>& planeStorage = buffers.planes();
+  RefinePlanes& planeStorage = buffers.planes();
   const bool storedPlanes = camera.projection == Projection::Perspective;
   prepareTriangles(scene, space, grid, depth, options.cull, filter, &sc, SetupPath::Fast, &setupStorage,
                    {camera.eye(), storedPlanes ? &planeStorage : nullptr});

@@ -252,7 +252,6 @@ struct SetupChunk {
 struct ChunkOutput {
   uint32_t inputs = 0;  // the chunk's triangles
   std::vector<TriangleSetup> setups;
-  std::vector<RefinePlane> planes;  // one per setup, when asked (RefinePlaneRequest)
   SetupCounters counters;
 };
 
@@ -490,23 +489,13 @@ void computeVertexCodes(const Scene& scene, const ClipSpace& space, const Sample
 
 // `*v` emptied, with capacity for n elements: fresh storage is advised
 // to use huge pages; reused storage was advised when it was made.
-template <typename T>
-void reserveReused(size_t n, std::vector<T>* v) {
+template <typename T, typename A>
+void reserveReused(size_t n, std::vector<T, A>* v) {
   v->clear();
   if (v->capacity() >= n) return;
-  std::vector<T>().swap(*v);
+  std::vector<T, A>().swap(*v);
   v->reserve(n);
   adviseHugePages(v->data(), v->capacity() * sizeof(T));
-}
-
-// A chunk's refinement planes (all its setups lie on one instance), in
-// lanes while its corners are in cache.
-void chunkPlanes(const Scene& scene, uint32_t instance, const glm::dvec3& eye, ChunkOutput* out) {
-  thread_local std::vector<uint32_t> triangles;
-  triangles.resize(out->setups.size());
-  for (size_t i = 0; i < out->setups.size(); ++i) triangles[i] = out->setups[i].triangle;
-  out->planes.resize(out->setups.size());
-  refinePlanes(scene, instance, triangles.data(), triangles.size(), eye, out->planes.data());
 }
 
 }  // namespace
@@ -576,7 +565,6 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
       setupChunkFast(context, codes, chunks[c], out.get());
     else
       setupChunkReference(context, chunks[c], out.get());
-    if (refine.planes) chunkPlanes(scene, chunks[c].instance, refine.eye, out.get());
     outputs[c] = std::move(out);
     tsanRelease(&outputs[c]);
     return c;
@@ -589,13 +577,9 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
     appendedInputs += out->inputs;
     // Clipping made more pieces than the reserve foresaw: grow
     // once by what the remaining inputs can still need.
-    if (setups.size() + out->setups.size() > setups.capacity()) {
-      const size_t need = setups.size() + out->setups.size() + (inputs - std::min(inputs, appendedInputs));
-      setups.reserve(need);
-      if (refine.planes) refine.planes->reserve(need);
-    }
+    if (setups.size() + out->setups.size() > setups.capacity())
+      setups.reserve(setups.size() + out->setups.size() + (inputs - std::min(inputs, appendedInputs)));
     setups.insert(setups.end(), out->setups.begin(), out->setups.end());
-    if (refine.planes) refine.planes->insert(refine.planes->end(), out->planes.begin(), out->planes.end());
     add(out->counters, counters);
     tsanRelease(&setups);
   };
@@ -605,6 +589,17 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
   edges.fork();
   tbb::parallel_pipeline(tokens, filters);
   edges.join();
+  if (!refine.planes) return;
+  // The refinement planes, written in place (sized without zeroing) in
+  // parallel blocks of setups.
+  RefinePlanes& planes = *refine.planes;
+  planes.resize(setups.size());
+  constexpr size_t kPlaneBlock = 4096;
+  parallelFor(size_t(0), (setups.size() + kPlaneBlock - 1) / kPlaneBlock, [&](size_t b) {
+    const size_t first = b * kPlaneBlock;
+    refinePlanes(scene, setups.data() + first, std::min(kPlaneBlock, setups.size() - first), refine.eye,
+                 planes.data() + first);
+  });
 }
 
 }  // namespace rastray

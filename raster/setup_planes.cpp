@@ -137,8 +137,8 @@ RefinePlane refinePlaneReference(const Scene& scene, uint32_t instance, uint32_t
   return p;
 }
 
-void refinePlanes(const Scene& scene, uint32_t instance, const uint32_t* triangle, size_t count,
-                  const glm::dvec3& eye, RefinePlane* out) {
+void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count, const glm::dvec3& eye,
+                  RefinePlane* out) {
   using setup_planes_detail::kBlock;
   if (count == 0) return;
   // Per thread: 12 KB, reused by every chunk the thread sets up.
@@ -146,11 +146,11 @@ void refinePlanes(const Scene& scene, uint32_t instance, const uint32_t* triangl
   setup_planes_detail::PlaneBlock& b = block;
   const double eyeLanes[3] = {eye.x, eye.y, eye.z};
   const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(PlaneLanes)();
-  const uint32_t firstTriangle = scene.instances[instance].firstTriangle;
   for (size_t first = 0; first < count; first += kBlock) {
     const size_t n = std::min(kBlock, count - first);
     for (size_t k = 0; k < n; ++k) {
-      const glm::uvec3 v = scene.triangles[size_t(firstTriangle) + triangle[first + k]];
+      const TriangleSetup& t = setups[first + k];
+      const glm::uvec3 v = scene.triangle(t.instance, t.triangle);
       for (int c = 0; c < 3; ++c) {
         const glm::vec3& p = scene.positions[v[c]];
         b.c[c][0][k] = double(p.x), b.c[c][1][k] = double(p.y), b.c[c][2][k] = double(p.z);

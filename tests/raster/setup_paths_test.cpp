@@ -242,25 +242,33 @@ TEST(SetupPaths, RefinePlanesInLanesGiveTheReferenceBitsOnEveryTarget) {
           glm::uvec3(2, 0, 1), glm::uvec3(2, 1, 0), glm::uvec3(0, 0, 1), glm::uvec3(1, 1, 1)})
       t.push_back(glm::uvec3(3 * k) + o);
   Scene scene;
-  test::addMesh(scene, {glm::vec3(0.0f)}, {});
+  test::addMesh(scene,
+                {glm::vec3(2.0f, -1.0f, 0.5f), glm::vec3(-1.0f, 0.0f, 3.0f), glm::vec3(0.0f, 4.0f, -2.0f)},
+                {{0, 1, 2}});
   test::addMesh(scene, p, t);
   const uint32_t instance = 1;
   std::vector<uint32_t> triangles(t.size());
   for (uint32_t i = 0; i < triangles.size(); ++i) triangles[i] = i;
   std::shuffle(triangles.begin(), triangles.end(), rng);
+  // Setups of those triangles (only their ids are read), and of instance
+  // 0's: blocks that span instances.
+  std::vector<TriangleSetup> setups(triangles.size());
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    setups[i].instance = i % 13 == 0 ? 0 : instance;
+    setups[i].triangle = i % 13 == 0 ? 0 : triangles[i];
+  }
   for (const glm::dvec3 eye :
        {glm::dvec3(0.3, 0.6, 0.4), glm::dvec3(-0.0, 0.0, -0.0), glm::dvec3(1e7, -3e6, 2.5)}) {
     std::vector<RefinePlane> expected(triangles.size());
     for (size_t i = 0; i < triangles.size(); ++i)
-      expected[i] = refinePlaneReference(scene, instance, triangles[i], eye);
+      expected[i] = refinePlaneReference(scene, setups[i].instance, setups[i].triangle, eye);
     for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
       SCOPED_TRACE(hwy::TargetName(target));
       hwy::SetSupportedTargetsForTest(target);
       for (size_t batch : {size_t(1), size_t(5), size_t(64), size_t(200)}) {
         std::vector<RefinePlane> out(triangles.size());
         for (size_t first = 0; first < triangles.size(); first += batch)
-          refinePlanes(scene, instance, &triangles[first], std::min(batch, triangles.size() - first), eye,
-                       &out[first]);
+          refinePlanes(scene, &setups[first], std::min(batch, setups.size() - first), eye, &out[first]);
         for (size_t i = 0; i < triangles.size(); ++i)
           ASSERT_TRUE(samePlane(out[i], expected[i])) << batch << " " << i << " triangle " << triangles[i];
       }
@@ -284,7 +292,7 @@ TEST(SetupPaths, StoredRefinePlanesAreEachSetupsReferencePlane) {
     SetupCounters n0, n1;
     const std::vector<TriangleSetup> plain = setUp(scene, f, CullMode::None, {}, path, &n0);
     std::vector<TriangleSetup> setups;
-    std::vector<RefinePlane> planes{RefinePlane{}};  // stale contents are replaced
+    RefinePlanes planes(3);  // stale contents are replaced
     prepareTriangles(scene, f.space, f.grid, f.depth, CullMode::None, {}, &n1, path, &setups,
                      {f.camera.eye(), &planes});
     expectSameCounters(n0, n1, "with planes");
