@@ -226,7 +226,26 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     if (!keysOnly) winners[i] = index;
   };
 
-  for (uint32_t index : bin) {
+  // A triangle whose pixels within the rect lie in one block and hold at
+  // most this many samples takes the small-triangle path below.
+  constexpr int kSmallSamples = 16;
+  alignas(16) int64_t smallOffsets[3][kSmallSamples];
+  uint64_t smallMasks[kSmallSamples];
+  // The next triangles' setups (272 bytes each, mostly not in cache at
+  // 10^6 triangles) are fetched this many triangles ahead.
+  constexpr size_t kPrefetch = 4;
+  const size_t binSize = bin.size();
+  for (size_t n = 0; n < binSize; ++n) {
+    const uint32_t index = bin[n];
+    if (n + kPrefetch < binSize) {
+      // The fields the walk reads: the first 160 bytes (ids, vertices,
+      // edges, bounds, depth plane), up to four cache lines.
+      const char* next = reinterpret_cast<const char*>(&setups[bin[n + kPrefetch]]);
+      __builtin_prefetch(next);
+      __builtin_prefetch(next + 64);
+      __builtin_prefetch(next + 128);
+      __builtin_prefetch(next + 159);
+    }
     const TriangleSetup& t = setups[index];
     const uint64_t id = t.id();
     const bool traceHere = tracedIn(trace, t, rect);
@@ -247,10 +266,92 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     const PixelBounds r = boundsIn(t, rect);
     if (r.empty()) continue;
     counters->coverageTests += r.samples(spp);
-    prepareOffsets(t, grid, scratch);
-    const uint32_t triangleKey = minKeyOverTriangle(t, format, U);
-    uint64_t* masks = scratch.masks.data();
+    // The triangle's lowest key, computed when the hierarchical test first
+    // needs it (a block of a cleared rect that still holds a cleared
+    // sample never does).
+    uint32_t triangleKey = 0;
+    bool haveTriangleKey = false;
+    const auto lowestKeyOver = [&](const PixelBlock& b) {
+      if (!haveTriangleKey) {
+        triangleKey = minKeyOverTriangle(t, format, U);
+        haveTriangleKey = true;
+      }
+      return std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos));
+    };
+    // The same test as `test` above without the trace (not traced here):
+    // one sample of the block `written` counts for.
+    const auto testKey = [&](int px, int py, int s, uint32_t key, uint32_t& written, uint32_t& writtenMax)
+        __attribute__((always_inline)) {
+      const size_t i = target->index(px, py, s);
+      const uint32_t stored = keys[i];
+      if (key > stored) return;
+      if (key == stored &&
+          (keysOnly || !passesDepthTest(func, key, id, stored,
+                                        winners[i] == kNoSetup ? UINT64_MAX : setups[winners[i]].id())))
+        return;
+      if (alphaTest && !alphaTest(t, px, py, s)) {
+        ++counters->alphaRejected;
+        return;
+      }
+      ++counters->samplesPassed;
+      keys[i] = key;
+      if (!keysOnly) winners[i] = index;
+      ++written;
+      writtenMax = std::max(writtenMax, key);
+    };
     constexpr int B = kCoverageBlock;
+    const int w = r.x1 - r.x0 + 1, h = r.y1 - r.y0 + 1;
+    if ((r.x0 - rect.x0) / B == (r.x1 - rect.x0) / B && (r.y0 - rect.y0) / B == (r.y1 - rect.y0) / B &&
+        w * h * spp <= kSmallSamples) {
+      // Small triangle: its pixels lie in one block and hold a few samples.
+      // Their masks straight from the edge functions, E + bias >= 0 at
+      // each sample (exact int64: the rule block_coverage.h's masks
+      // implement), without classifying the block or preparing its int32
+      // lanes; then the block's hierarchical test, the depth tests in the
+      // partial-block order (sample, then pixel) and the same counts, so
+      // the keys, winners and counters are the block walk's.
+      for (int e = 0; e < 3; ++e)
+        for (int k = 0; k < spp; ++k)
+          smallOffsets[e][k] =
+              t.edge[e].a * grid.offsets[size_t(k)].x + t.edge[e].b * grid.offsets[size_t(k)].y;
+      uint64_t any = 0;
+      for (int k = 0; k < spp; ++k) smallMasks[k] = 0;
+      for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i) {
+          const int64_t X = int64_t(r.x0 + i) * U, Y = int64_t(r.y0 + j) * U;
+          const int64_t e0 = t.edge[0].at(X, Y) + t.edge[0].bias;
+          const int64_t e1 = t.edge[1].at(X, Y) + t.edge[1].bias;
+          const int64_t e2 = t.edge[2].at(X, Y) + t.edge[2].bias;
+          for (int k = 0; k < spp; ++k) {
+            const bool in = (e0 + smallOffsets[0][k] >= 0) & (e1 + smallOffsets[1][k] >= 0) &
+                            (e2 + smallOffsets[2][k] >= 0);
+            smallMasks[k] |= uint64_t(in) << (8 * j + i);
+          }
+        }
+      for (int k = 0; k < spp; ++k) any |= smallMasks[k];
+      if (any == 0) continue;
+      const PixelBlock b{r.x0, r.y0, w, h};
+      const size_t hb = bounds.block(r.x0, r.y0);
+      if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
+      uint32_t written = 0, writtenMax = 0;
+      for (int k = 0; k < spp; ++k) {
+        uint64_t m = smallMasks[k];
+        counters->samplesTested += uint64_t(bitCount(m));
+        while (m) {
+          const int bit = __builtin_ctzll(m);
+          m &= m - 1;
+          const int px = r.x0 + (bit & 7), py = r.y0 + (bit >> 3);
+          testKey(px, py, k, sampleDepthKey(t, grid, format, px, py, k), written, writtenMax);
+        }
+      }
+      if (written != 0) {
+        bounds.addWrites(hb, written);
+        bounds.markStale(hb);
+      }
+      continue;
+    }
+    prepareOffsets(t, grid, scratch);
+    uint64_t* masks = scratch.masks.data();
     for (int by = rect.y0 + (r.y0 - rect.y0) / B * B; by <= r.y1; by += B)
       for (int bx = rect.x0 + (r.x0 - rect.x0) / B * B; bx <= r.x1; bx += B) {
         const int cx0 = std::max(bx, r.x0), cy0 = std::max(by, r.y0);
@@ -260,30 +361,8 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         const BlockClass c = classifyBlock(t, scratch, U, b, lo);
         if (c == BlockClass::Reject) continue;
         const size_t hb = bounds.block(bx, by);
-        if (bounds.culls(hb, spp, [&] {
-              return std::max(triangleKey, minKeyOverBlock(t, format, b, lowPos, highPos));
-            }))
-          continue;
-        // The same test as `test` above without the trace (not traced here).
+        if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
         uint32_t written = 0, writtenMax = 0;
-        const auto testKey = [&](int px, int py, int s, uint32_t key) __attribute__((always_inline)) {
-          const size_t i = target->index(px, py, s);
-          const uint32_t stored = keys[i];
-          if (key > stored) return;
-          if (key == stored &&
-              (keysOnly || !passesDepthTest(func, key, id, stored,
-                                            winners[i] == kNoSetup ? UINT64_MAX : setups[winners[i]].id())))
-            return;
-          if (alphaTest && !alphaTest(t, px, py, s)) {
-            ++counters->alphaRejected;
-            return;
-          }
-          ++counters->samplesPassed;
-          keys[i] = key;
-          if (!keysOnly) winners[i] = index;
-          ++written;
-          writtenMax = std::max(writtenMax, key);
-        };
         if (c == BlockClass::Accept) {
           // Every sample covered: each block row's keys eight at a time
           // (depth_keys.h: the bits of sampleDepthKey), then tested.
@@ -317,7 +396,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
                   continue;
                 }
               }
-              for (int k = 0; k < b.w; ++k) testKey(b.x + k, py, s, rowKeys[k]);
+              for (int k = 0; k < b.w; ++k) testKey(b.x + k, py, s, rowKeys[k], written, writtenMax);
             }
           }
           if (written == 0) continue;
@@ -336,7 +415,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
             const int bit = __builtin_ctzll(m);
             m &= m - 1;
             const int px = b.x + (bit & 7), py = b.y + (bit >> 3);
-            testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s));
+            testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s), written, writtenMax);
           }
         }
         if (written != 0) {

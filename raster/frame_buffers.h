@@ -46,6 +46,7 @@ class RasterFrameBuffers {
   DepthTarget target_;
   FlatImage image_;
   std::vector<TriangleSetup> setups_;
+  RefinePlanes planes_;
 };
 
 // One frame's use of a pool (raster/rasterizer.cpp): takes the buffers for
@@ -66,11 +67,14 @@ class FrameBufferLease {
   // Storage for the frame's triangle setups (prepareTriangles' `setups`):
   // the pool's, kept with its capacity between frames, else the lease's own.
   std::vector<TriangleSetup>& setups() { return pool_ ? pool_->setups_ : ownSetups_; }
+  // The same for their refinement planes (prepareTriangles' RefinePlaneRequest).
+  RefinePlanes& planes() { return pool_ ? pool_->planes_ : ownPlanes_; }
 
  private:
   RasterFrameBuffers* pool_ = nullptr;  // null: not leased (no pool, or busy)
   DepthTarget own_;
   std::vector<TriangleSetup> ownSetups_;
+  RefinePlanes ownPlanes_;
 };
 
 }  // namespace rastray

@@ -23,6 +23,8 @@ void addRasterFrameMemory(const Scene& scene, const RasterOptions& options, uint
   const uint64_t triangles = scene.triangleCount();
   const uint64_t setupBytes = mulSat(triangles, sizeof(TriangleSetup));
   transient.add("triangle setups", setupBytes);
+  // The camera pass's refinement plane per setup (raster/setup.h: RefinePlane).
+  transient.add("refinement planes", mulSat(triangles, sizeof(RefinePlane)));
   // The setup's per-vertex codes, alive while setups are made (raster/setup.h).
   transient.add("setup vertex codes", mulSat(scene.positions.size(), kSetupVertexCodeBytes));
   transient.add("tile bins", mulSat(triangles, kBinBytesPerTriangle));

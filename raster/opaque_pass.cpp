@@ -59,7 +59,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     uint32_t source;  // the sample whose colour it takes
   };
   thread_local std::vector<Assignment> assignments;
-  PrimaryBatch batch(primaryConstants_, scene_, setups_.data());
+  PrimaryBatch batch(primaryConstants_, scene_, setups_.data(), planes_);
   batch.wantInterpolated(!lean);  // the lean form reads no front hits
   PrimaryHitShader kernel(shader_, shadingPath());
   alignas(64) uint32_t localOut[kPrimaryHitBlock];  // the sample each is shaded at

@@ -195,10 +195,12 @@ void primarySamplesReference(const PrimaryRayConstants& camera, const TriangleSe
   }
 }
 
-PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups)
+PrimaryBatch::PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
+                           const RefinePlane* planes)
     : camera_(camera),
       scene_(scene),
       setups_(setups),
+      refinePlanes_(planes),
       // Not value-initialised (about 30 KB a tile): every lane and run
       // entry is written before it is read.
       block_(new primary_detail::FusedBlock),
@@ -272,6 +274,10 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
       continue;
     }
     if (win != last || runs == 0) {
+      // Small triangles make runs of one or two samples, each on a setup
+      // (and its refinement plane) mostly not in cache: the one a few
+      // samples on is fetched now.
+      if (i + kRunPrefetch < n && winners[i + kRunPrefetch] != kNoSetup) prefetchRun(winners[i + kRunPrefetch]);
       fillRun(runs++, win, used);
       last = win;
     }
@@ -306,6 +312,20 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
   return i;
 }
 
+void PrimaryBatch::prefetchRun(uint32_t winner) const {
+  // The bytes fillRun reads: the setup's ids and planes, the refinement plane.
+  const char* t = reinterpret_cast<const char*>(&setups_[winner]);
+  __builtin_prefetch(t);
+  __builtin_prefetch(t + offsetof(TriangleSetup, depth));
+  __builtin_prefetch(t + offsetof(TriangleSetup, dOverW));
+  __builtin_prefetch(t + offsetof(TriangleSetup, b2OverW) + sizeof(PlaneCoefficients) - 1);
+  if (refinePlanes_) {
+    const char* p = reinterpret_cast<const char*>(&refinePlanes_[winner]);
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + sizeof(RefinePlane) - 1);
+  }
+}
+
 // Run r: its setup's planes and its stored triangle's plane.
 void PrimaryBatch::fillRun(size_t r, uint32_t winner, size_t firstLane) {
   primary_detail::FusedBlock& b = *block_;
@@ -316,6 +336,21 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner, size_t firstLane) {
   b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
   b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
   b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
+  runFirst_[r] = uint32_t(firstLane);
+  runInstance_[r] = t.instance;
+  runTriangle_[r] = t.triangle;
+  if (refinePlanes_) {
+    // Computed in setup (raster/setup.h: RefinePlane).
+    const RefinePlane& p = refinePlanes_[winner];
+    b.e1x[r] = p.e1.x, b.e1y[r] = p.e1.y, b.e1z[r] = p.e1.z;
+    b.e2x[r] = p.e2.x, b.e2y[r] = p.e2.y, b.e2z[r] = p.e2.z;
+    b.sx[r] = p.s.x, b.sy[r] = p.s.y, b.sz[r] = p.s.z;
+    b.qx[r] = p.q.x, b.qy[r] = p.q.y, b.qz[r] = p.q.z;
+    b.e2DotQ[r] = p.e2DotQ;
+    b.slot1[r] = double(p.slot1);
+    b.slot2[r] = double(p.slot2);
+    return;
+  }
   const size_t slot = (t.triangle * 2654435761u + t.instance * 40503u) >> (32 - kPlaneCacheBits);
   Plane& p = planes_[slot];
   const uint64_t key = t.id();
@@ -338,9 +373,6 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner, size_t firstLane) {
   b.e2DotQ[r] = p.e2DotQ;
   b.slot1[r] = p.slot1;
   b.slot2[r] = p.slot2;
-  runFirst_[r] = uint32_t(firstLane);
-  runInstance_[r] = t.instance;
-  runTriangle_[r] = t.triangle;
 }
 
 void PrimaryBatch::run() {

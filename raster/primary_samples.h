@@ -107,7 +107,11 @@ struct FusedBlock {
 // bits as primaryShadeHits, which runs through it.
 class PrimaryBatch {
  public:
-  PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups);
+  // `planes`, when given, holds each setup's stored-triangle plane for
+  // camera.eye (prepareTriangles' RefinePlaneRequest; the same bits as
+  // computing it here), read instead of computed.
+  PrimaryBatch(const PrimaryRayConstants& camera, const Scene& scene, const TriangleSetup* setups,
+               const RefinePlane* planes = nullptr);
   ~PrimaryBatch();
   PrimaryBatch(const PrimaryBatch&) = delete;
   PrimaryBatch& operator=(const PrimaryBatch&) = delete;
@@ -165,10 +169,13 @@ class PrimaryBatch {
 
  private:
   void fillRun(size_t r, uint32_t winner, size_t firstLane);  // run r's table entry
+  void prefetchRun(uint32_t winner) const;  // what fillRun will read for it
+  static constexpr size_t kRunPrefetch = 8;  // samples ahead in addRow
 
   const PrimaryRayConstants& camera_;
   const Scene& scene_;
   const TriangleSetup* setups_;
+  const RefinePlane* refinePlanes_;
   std::unique_ptr<primary_detail::FusedBlock> block_;
   size_t used_ = 0, runs_ = 0;
   uint32_t lastWinner_ = 0;

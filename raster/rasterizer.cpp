@@ -110,7 +110,13 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   // depth target below.
   FrameBufferLease buffers(options.frameBuffers);
   std::vector<TriangleSetup>& setupStorage = buffers.setups();
-  prepareTriangles(scene, space, grid, depth, options.cull, filter, &sc, SetupPath::Fast, &setupStorage);
+  // The camera pass's refinement planes (raster/setup.h: RefinePlane),
+  // computed in lanes while setup has the corners in cache. A perspective
+  // camera only: the orthographic path refines with the scalar steps.
+  RefinePlanes& planeStorage = buffers.planes();
+  const bool storedPlanes = camera.projection == Projection::Perspective;
+  prepareTriangles(scene, space, grid, depth, options.cull, filter, &sc, SetupPath::Fast, &setupStorage,
+                   {camera.eye(), storedPlanes ? &planeStorage : nullptr});
   const std::vector<TriangleSetup>& setups = setupStorage;
   out.timings.emplace_back("raster.setup", secondsSince(start));
 
@@ -132,7 +138,8 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
 
   // Every tile: pass 1, shading, pass 2, compositing, resolve.
   start = Clock::now();
-  const TileRenderer renderer(scene, analysis, camera, options, shader, grid, setups);
+  const TileRenderer renderer(scene, analysis, camera, options, shader, grid, setups,
+                              storedPlanes ? planeStorage.data() : nullptr);
   // A frame-sized depth target only where the wireframe reads it after
   // the tiles; otherwise each tile keeps a target of its own rectangle.
   // Reused storage holds the last frame's values: each tile clears its

@@ -487,6 +487,17 @@ void computeVertexCodes(const Scene& scene, const ClipSpace& space, const Sample
   });
 }
 
+// `*v` emptied, with capacity for n elements: fresh storage is advised
+// to use huge pages; reused storage was advised when it was made.
+template <typename T, typename A>
+void reserveReused(size_t n, std::vector<T, A>* v) {
+  v->clear();
+  if (v->capacity() >= n) return;
+  std::vector<T, A>().swap(*v);
+  v->reserve(n);
+  adviseHugePages(v->data(), v->capacity() * sizeof(T));
+}
+
 }  // namespace
 
 std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace& space,
@@ -499,7 +510,8 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
 
 void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
                       const DepthSettings& depth, CullMode cull, TriangleFilter filter,
-                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* storage) {
+                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* storage,
+                      RefinePlaneRequest refine) {
   // Chunks of one instance's triangles, set up in parallel and appended in
   // chunk order by a pipeline: deterministic whatever the scheduling, and
   // only the chunks in flight (a few per thread) exist besides the result,
@@ -524,13 +536,8 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
   // capacity is reserved once, and pages the setups never reach are never
   // touched (so they cost address space, not memory).
   std::vector<TriangleSetup>& setups = *storage;
-  setups.clear();
-  if (setups.capacity() < inputs) {
-    // Fresh storage (reused storage was advised when it was made).
-    std::vector<TriangleSetup>().swap(setups);
-    setups.reserve(inputs);
-    adviseHugePages(setups.data(), setups.capacity() * sizeof(TriangleSetup));
-  }
+  reserveReused(inputs, &setups);
+  if (refine.planes) reserveReused(inputs, refine.planes);
   size_t next = 0, appendedInputs = 0;
   const size_t tokens = 4 * size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
   // A chunk's output waits in its slot from the parallel stage to the ordered
@@ -582,6 +589,17 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
   edges.fork();
   tbb::parallel_pipeline(tokens, filters);
   edges.join();
+  if (!refine.planes) return;
+  // The refinement planes, written in place (sized without zeroing) in
+  // parallel blocks of setups.
+  RefinePlanes& planes = *refine.planes;
+  planes.resize(setups.size());
+  constexpr size_t kPlaneBlock = 4096;
+  parallelFor(size_t(0), (setups.size() + kPlaneBlock - 1) / kPlaneBlock, [&](size_t b) {
+    const size_t first = b * kPlaneBlock;
+    refinePlanes(scene, setups.data() + first, std::min(kPlaneBlock, setups.size() - first), refine.eye,
+                 planes.data() + first);
+  });
 }
 
 }  // namespace rastray

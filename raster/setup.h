@@ -36,6 +36,9 @@
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <memory>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "common/scene.h"
@@ -198,12 +201,76 @@ std::vector<TriangleSetup> prepareTriangles(const Scene& scene, const ClipSpace&
                                             TriangleFilter filter, SetupCounters* counters,
                                             SetupPath path = SetupPath::Fast);
 
+// The stored triangle's plane as the camera pass's refinement reads it
+// (raster/primary_samples.h; RefinePlaneLanes in
+// common/primary_refinement-inl.h): trianglePlane's edges e1, e2 and
+// slots (common/triangle_plane.h), and the terms of a ray from `eye`,
+// s = eye − a, q = s × e1, e2DotQ = e2 · q, bit for bit as
+// intersectTrianglePlane's memo computes them. A function of the
+// triangle's corners and the eye alone. 112 bytes.
+struct RefinePlane {
+  glm::dvec3 e1, e2, s, q;
+  double e2DotQ;
+  int32_t slot1, slot2;  // canonical rank of stored corners 1 and 2
+};
+static_assert(std::is_trivially_default_constructible<RefinePlane>::value,
+              "RefinePlanes is sized without writing");
+
+// An allocator whose value-construction leaves a trivial type unwritten:
+// resizing RefinePlanes does not zero hundreds of MB that are written
+// right after.
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <typename U>
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+using RefinePlanes = std::vector<RefinePlane, DefaultInitAllocator<RefinePlane>>;
+
+// The scalar reference: trianglePlane (its per-thread memo, its sorting
+// network) then glm's cross and dot, one triangle at a time.
+RefinePlane refinePlaneReference(const Scene& scene, uint32_t instance, uint32_t triangle,
+                                 const glm::dvec3& eye);
+
+// out[i] = refinePlaneReference(scene, setups[i].instance,
+// setups[i].triangle, eye) for i < count, bit for bit on every target: the
+// corners' sorting network as masked compare-exchanges and the products in
+// Highway double lanes (the reference's operations in its order, no
+// contraction).
+void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count, const glm::dvec3& eye,
+                  RefinePlane* out);
+
+// What the camera pass asks of setup besides the setups: planes[i] =
+// refinePlaneReference(scene, setups[i].instance, setups[i].triangle, eye)
+// for every setup, computed in lanes in parallel blocks once the setups
+// are in place and written in place, so the fused pass reads one entry per
+// run of samples instead of sorting corners on a cache miss. Storage
+// reused as for the setups.
+struct RefinePlaneRequest {
+  glm::dvec3 eye{0.0};
+  RefinePlanes* planes = nullptr;
+};
+
 // The same into `*setups`, whose previous contents are replaced and whose
 // storage is reused when large enough: a caller that sets up frame after
 // frame (raster/frame_buffers.h) does not map, fault in and zero fresh
 // pages for every frame's setups (hundreds of MB at 10^6 triangles).
+// With `refine.planes`, also the refinement planes of every setup.
 void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
                       const DepthSettings& depth, CullMode cull, TriangleFilter filter,
-                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* setups);
+                      SetupCounters* counters, SetupPath path, std::vector<TriangleSetup>* setups,
+                      RefinePlaneRequest refine = {});
 
 }  // namespace rastray

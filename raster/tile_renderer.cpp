@@ -32,7 +32,7 @@ ThreadCounters& ThreadCounters::operator+=(const ThreadCounters& other) {
 
 TileRenderer::TileRenderer(const Scene& scene, const SceneAnalysis& analysis, const Camera& camera,
                            const RasterOptions& options, const Shader& shader, const SampleGrid& grid,
-                           const std::vector<TriangleSetup>& setups)
+                           const std::vector<TriangleSetup>& setups, const RefinePlane* planes)
     : scene_(scene),
       analysis_(analysis),
       camera_(camera),
@@ -40,6 +40,7 @@ TileRenderer::TileRenderer(const Scene& scene, const SceneAnalysis& analysis, co
       shader_(shader),
       grid_(grid),
       setups_(setups),
+      planes_(planes),
       rays_(camera),
       primaryConstants_(camera),
       centre_(centreSampleIndex(options.spp)) {}

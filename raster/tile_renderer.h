@@ -98,7 +98,7 @@ class TileRenderer {
  public:
   TileRenderer(const Scene& scene, const SceneAnalysis& analysis, const Camera& camera,
                const RasterOptions& options, const Shader& shader, const SampleGrid& grid,
-               const std::vector<TriangleSetup>& setups);
+               const std::vector<TriangleSetup>& setups, const RefinePlane* planes = nullptr);
 
   // Pass 1, deferred shading, pass 2, compositing, resolve, hits and deep
   // samples of one tile. `frameTarget` is the frame's depth target, for a
@@ -177,6 +177,7 @@ class TileRenderer {
   const Shader& shader_;
   const SampleGrid& grid_;
   const std::vector<TriangleSetup>& setups_;
+  const RefinePlane* planes_;             // per setup, or null (PrimaryBatch)
   PrimaryRays rays_;                      // camera_'s primary rays (bit-identical to Camera::primaryRay)
   PrimaryRayConstants primaryConstants_;  // the same rays for primarySamples' lanes
   int centre_;

@@ -284,6 +284,71 @@ TEST(CoverageEquivalence, ClearedRectsGiveTheSameTargetAndCounters) {
   }
 }
 
+// The depth pass's small-triangle path (pixels within one block, at most
+// 16 samples: masks straight from the edge functions) against the
+// reference walk: a grid of sub-pixel to 3-pixel triangles over the image
+// with a coplanar copy of part of it (exact key ties, decided by id), tiny
+// random triangles on the 1/16-pixel grid (edges through sample
+// positions: the fill rule), at 1, 4 and 16 spp, two depth formats, both
+// functions, keys only, MASK, orthographic and perspective.
+TEST(CoverageEquivalence, SmallTrianglePathWritesTheReferenceKeysAndWinners) {
+  Scene scene;
+  std::mt19937 rng(17);
+  const auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  for (const double cell : {1.1, 2.3}) {
+    const int cells = int(kSize / cell);
+    std::vector<glm::vec3> p;
+    std::vector<glm::uvec3> t;
+    for (int y = 0; y <= cells; ++y)
+      for (int x = 0; x <= cells; ++x)
+        p.push_back(world(x * cell + 0.3, y * cell + 0.1, -1.0 - uniform(0.0, 0.05)));
+    for (int y = 0; y < cells; ++y)
+      for (int x = 0; x < cells; ++x) {
+        const uint32_t a = uint32_t(y * (cells + 1) + x);
+        t.push_back({a, a + 1, a + uint32_t(cells) + 2});
+        t.push_back({a, a + uint32_t(cells) + 2, a + uint32_t(cells) + 1});
+      }
+    test::addMesh(scene, p, t);
+    t.resize(t.size() / 3);
+    test::addMesh(scene, p, t);  // the copy: exact ties
+  }
+  std::vector<glm::vec3> p;
+  std::vector<glm::uvec3> t;
+  const auto snap = [](double v) { return std::round(v * 16.0) / 16.0; };
+  for (uint32_t k = 0; k < 1500; ++k) {
+    const double cx = snap(uniform(-2.0, kSize + 2.0)), cy = snap(uniform(-2.0, kSize + 2.0));
+    const double z = -uniform(0.5, 1.2);
+    for (int v = 0; v < 3; ++v)
+      p.push_back(world(cx + snap(uniform(-1.5, 1.5)), cy + snap(uniform(-1.5, 1.5)), z));
+    t.push_back({3 * k, 3 * k + 1, 3 * k + 2});
+  }
+  test::addMesh(scene, p, t);
+  const Camera ortho = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
+  const Camera persp =
+      test::perspectiveCamera(kSize, kSize, 1.2, glm::dvec3(3, -2, 70), glm::dvec3(0, 0, 0), 0.5);
+  for (const int spp : {1, 4, 16})
+    for (const Camera* camera : {&ortho, &persp}) {
+      const DepthFormat format = camera == &ortho ? DepthFormat::FloatReversed : DepthFormat::Unorm16;
+      const SampleGrid grid = makeSampleGrid(spp, kSize, kSize);
+      const auto setups = setupScene(scene, *camera, grid, format);
+      for (const DepthFunc func : {DepthFunc::Less, DepthFunc::LEqual})
+        for (const bool keysOnly : {false, true}) {
+          if (keysOnly && func == DepthFunc::LEqual) continue;
+          const PassResult fast = depthPass(setups, grid, format, func, keysOnly, CoveragePath::Fast);
+          const PassResult slow = depthPass(setups, grid, format, func, keysOnly, CoveragePath::Reference);
+          const std::string what = "spp " + std::to_string(spp) + " " + toString(format) + " " +
+                                   toString(func) + (keysOnly ? " keys only" : "") +
+                                   (camera == &ortho ? " ortho" : " perspective");
+          ASSERT_EQ(fast.target.keys, slow.target.keys) << what;
+          ASSERT_EQ(fast.target.winners, slow.target.winners) << what;
+          EXPECT_EQ(fast.counters.coverageTests, slow.counters.coverageTests) << what;
+          EXPECT_EQ(fast.counters.samplesPassed, slow.counters.samplesPassed) << what;
+          EXPECT_EQ(fast.counters.alphaRejected, slow.counters.alphaRejected) << what;
+          EXPECT_LE(fast.counters.samplesTested, slow.counters.samplesTested) << what;
+        }
+    }
+}
+
 TEST(CoverageEquivalence, RendersMatchTheReferenceWalkWithMaskAndBlend) {
   Scene scene = randomScene(21, 120);
   // Every third instance MASK with a constant alpha below the cutoff on

@@ -33,6 +33,7 @@ TEST(RasterMemoryEstimate, SetupsAndDepthTargetScaleWithTrianglesAndSamples) {
   MemoryEstimate e;
   addRasterFrameMemory(scene, options, 640 * 480 * 4, 0.0, 2, e);
   EXPECT_EQ(part(e, "triangle setups"), 2000 * sizeof(TriangleSetup));
+  EXPECT_EQ(part(e, "refinement planes"), 2000 * sizeof(RefinePlane));
   EXPECT_EQ(part(e, "setup vertex codes"), 4000 * kSetupVertexCodeBytes);
   // Key and winner per sample: one tile's per thread, the whole frame's
   // only where the wireframe reads it after the tiles.

@@ -4,8 +4,10 @@
 // triangle that can cover a sample, the same bins, depth keys, winners and
 // hits as when every setup is kept.
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 #include <tbb/global_control.h>
 
+#include <cstring>
 #include <random>
 
 #include "raster/bin.h"
@@ -195,8 +197,121 @@ bool coversSomeSample(const TriangleSetup& t, const SampleGrid& grid, int width,
   return false;
 }
 
+// Bit for bit, signed zeros and NaNs included.
+bool samePlane(const RefinePlane& a, const RefinePlane& b) {
+  const auto same = [](const glm::dvec3& p, const glm::dvec3& q) {
+    return std::memcmp(&p, &q, sizeof p) == 0;
+  };
+  return same(a.e1, b.e1) && same(a.e2, b.e2) && same(a.s, b.s) && same(a.q, b.q) &&
+         std::memcmp(&a.e2DotQ, &b.e2DotQ, sizeof a.e2DotQ) == 0 && a.slot1 == b.slot1 && a.slot2 == b.slot2;
+}
+
+// The lanes against the reference on triangles whose corners tie in x, in
+// x and y, or entirely (the sorting network's every branch), with signed
+// zeros, far from the origin and tiny, in every corner order; blocks of 1
+// to 200, on every target.
+TEST(SetupPaths, RefinePlanesInLanesGiveTheReferenceBitsOnEveryTarget) {
+  std::mt19937 rng(7);
+  const float few[] = {-0.0f, 0.0f, 1.0f, -1.0f, 0.5f, 3.0f};
+  std::uniform_int_distribution<int> pick(0, 5), kind(0, 3);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<glm::vec3> p;
+  std::vector<glm::uvec3> t;
+  for (int k = 0; k < 600; ++k) {
+    const float scale = k % 7 == 0 ? 1e6f : k % 11 == 0 ? 1e-4f : 2.0f;
+    for (int v = 0; v < 3; ++v) {
+      glm::vec3 c;
+      switch (kind(rng)) {
+        case 0:  // coordinates from a few values: ties in x, y or all
+          c = {few[pick(rng)], few[pick(rng)], few[pick(rng)]};
+          break;
+        case 1:  // x shared with the previous corner
+          c = {v > 0 ? p.back().x : few[pick(rng)], unit(rng) * scale, unit(rng) * scale};
+          break;
+        default:
+          c = {unit(rng) * scale, unit(rng) * scale, unit(rng) * scale};
+      }
+      p.push_back(c);
+    }
+    t.push_back(glm::uvec3(3 * k, 3 * k + 1, 3 * k + 2));
+  }
+  // Every corner order of a few triangles, and a repeated corner.
+  for (int k = 0; k < 4; ++k)
+    for (const glm::uvec3 o :
+         {glm::uvec3(0, 1, 2), glm::uvec3(0, 2, 1), glm::uvec3(1, 0, 2), glm::uvec3(1, 2, 0),
+          glm::uvec3(2, 0, 1), glm::uvec3(2, 1, 0), glm::uvec3(0, 0, 1), glm::uvec3(1, 1, 1)})
+      t.push_back(glm::uvec3(3 * k) + o);
+  Scene scene;
+  test::addMesh(scene,
+                {glm::vec3(2.0f, -1.0f, 0.5f), glm::vec3(-1.0f, 0.0f, 3.0f), glm::vec3(0.0f, 4.0f, -2.0f)},
+                {{0, 1, 2}});
+  test::addMesh(scene, p, t);
+  const uint32_t instance = 1;
+  std::vector<uint32_t> triangles(t.size());
+  for (uint32_t i = 0; i < triangles.size(); ++i) triangles[i] = i;
+  std::shuffle(triangles.begin(), triangles.end(), rng);
+  // Setups of those triangles (only their ids are read), and of instance
+  // 0's: blocks that span instances.
+  std::vector<TriangleSetup> setups(triangles.size());
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    setups[i].instance = i % 13 == 0 ? 0 : instance;
+    setups[i].triangle = i % 13 == 0 ? 0 : triangles[i];
+  }
+  for (const glm::dvec3 eye :
+       {glm::dvec3(0.3, 0.6, 0.4), glm::dvec3(-0.0, 0.0, -0.0), glm::dvec3(1e7, -3e6, 2.5)}) {
+    std::vector<RefinePlane> expected(triangles.size());
+    for (size_t i = 0; i < triangles.size(); ++i)
+      expected[i] = refinePlaneReference(scene, setups[i].instance, setups[i].triangle, eye);
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      SCOPED_TRACE(hwy::TargetName(target));
+      hwy::SetSupportedTargetsForTest(target);
+      for (size_t batch : {size_t(1), size_t(5), size_t(64), size_t(200)}) {
+        std::vector<RefinePlane> out(triangles.size());
+        for (size_t first = 0; first < triangles.size(); first += batch)
+          refinePlanes(scene, &setups[first], std::min(batch, setups.size() - first), eye, &out[first]);
+        for (size_t i = 0; i < triangles.size(); ++i)
+          ASSERT_TRUE(samePlane(out[i], expected[i])) << batch << " " << i << " triangle " << triangles[i];
+      }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+  }
+}
+
+// prepareTriangles' planes: one per setup (clipped pieces included), each
+// the reference's for its triangle and the eye, on both setup paths; the
+// setups themselves as without them.
+TEST(SetupPaths, StoredRefinePlanesAreEachSetupsReferencePlane) {
+  Scene scene = terrainScene(160, 1);
+  // Triangles through the near plane, beside the eye: clipped into pieces.
+  test::addMesh(scene,
+                {glm::vec3(0.3f, 0.5f, 1.0f), glm::vec3(0.0f, 0.3f, -2.0f), glm::vec3(0.6f, 0.3f, -2.0f),
+                 glm::vec3(0.1f, 0.7f, 0.5f), glm::vec3(0.5f, 0.7f, 0.3f), glm::vec3(0.3f, 0.2f, -1.0f)},
+                {{0, 1, 2}, {3, 4, 5}});
+  const Frame f = frameOf(160, 90, 4);
+  for (const SetupPath path : {SetupPath::Fast, SetupPath::Reference}) {
+    SetupCounters n0, n1;
+    const std::vector<TriangleSetup> plain = setUp(scene, f, CullMode::None, {}, path, &n0);
+    std::vector<TriangleSetup> setups;
+    RefinePlanes planes(3);  // stale contents are replaced
+    prepareTriangles(scene, f.space, f.grid, f.depth, CullMode::None, {}, &n1, path, &setups,
+                     {f.camera.eye(), &planes});
+    expectSameCounters(n0, n1, "with planes");
+    ASSERT_EQ(setups.size(), plain.size());
+    ASSERT_EQ(planes.size(), setups.size());
+    size_t clipped = 0;
+    for (size_t i = 0; i < setups.size(); ++i) {
+      expectSameSetup(setups[i], plain[i], i);
+      clipped += setups[i].fromClipping;
+      ASSERT_TRUE(samePlane(
+          planes[i], refinePlaneReference(scene, setups[i].instance, setups[i].triangle, f.camera.eye())))
+          << i;
+    }
+    EXPECT_GT(clipped, 0u);
+  }
+}
+
 TEST(SamplelessSetups, OnlySetupsThatCoverNoSampleAreDropped) {
-  const Scene scene = terrainScene(120, 3);
+  const Scene scene = terrainScene(160, 1);
   for (int spp : {1, 4, 16}) {
     const Frame f = frameOf(96, 54, spp);
     TriangleFilter keepAll;

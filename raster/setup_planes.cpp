@@ -1,0 +1,180 @@
+// The refinement planes of setup.h (RefinePlane) a block of triangles at a
+// time in Highway double lanes. Highway compiles the lane function once per
+// SIMD target (foreach_target.h re-includes this file); the host code
+// gathers the corners, runs the lanes and scatters. Built with
+// -ffp-contract=off (the top-level CMakeLists.txt): every operation below
+// is the reference's (planeMemoFor's sorting network and subtractions in
+// common/surface.cpp, glm's cross and dot), in its order, so the bits are
+// the same on every target.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "raster/setup_planes.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <cstddef>
+#include <cstdint>
+
+#include <hwy/highway.h>
+
+#include "raster/setup.h"
+
+#ifndef RASTRAY_SETUP_PLANES_BLOCK_
+#define RASTRAY_SETUP_PLANES_BLOCK_
+namespace rastray {
+namespace setup_planes_detail {
+
+constexpr size_t kBlock = 64;  // a multiple of every target's double lane count
+
+// A block of triangles' corners (in stored order) and their planes.
+struct PlaneBlock {
+  size_t lanes = 0;                    // a whole number of vectors
+  alignas(64) double c[3][3][kBlock];  // [corner][axis][lane]
+  alignas(64) double e1[3][kBlock], e2[3][kBlock], s[3][kBlock], q[3][kBlock];
+  alignas(64) double e2DotQ[kBlock], slot1[kBlock], slot2[kBlock];
+};
+
+}  // namespace setup_planes_detail
+}  // namespace rastray
+#endif  // RASTRAY_SETUP_PLANES_BLOCK_
+
+HWY_BEFORE_NAMESPACE();
+namespace rastray {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Per lane: planeMemoFor (corners sorted lexicographically by three
+// compare-exchanges, a = the first, e1 and e2 the differences to the
+// others, the slots of stored corners 1 and 2), then intersectTrianglePlane's
+// origin terms for a ray from the eye: s = eye − a, q = glm::cross(s, e1)
+// = (s.y·e1.z − e1.y·s.z, s.z·e1.x − e1.z·s.x, s.x·e1.y − e1.x·s.y),
+// e2DotQ = glm::dot(e2, q) = (e2.x·q.x + e2.y·q.y) + e2.z·q.z.
+void LanesRefinePlanes(setup_planes_detail::PlaneBlock* b, const double* eye) {
+  const hn::ScalableTag<double> d;
+  using V = hn::Vec<decltype(d)>;
+  using M = hn::Mask<decltype(d)>;
+  const size_t N = hn::Lanes(d);
+  const V ex = hn::Set(d, eye[0]), ey = hn::Set(d, eye[1]), ez = hn::Set(d, eye[2]);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0);
+  struct Corner {
+    V x, y, z, index;
+  };
+  // The reference's `less`: x decides unless equal, then y, then z (a NaN
+  // compares unequal and not less, as there).
+  const auto less = [&](const Corner& p, const Corner& q) -> M {
+    const M ltZ = hn::Lt(p.z, q.z);
+    const M ltY = hn::Or(hn::Lt(p.y, q.y), hn::And(hn::Eq(p.y, q.y), ltZ));
+    return hn::Or(hn::Lt(p.x, q.x), hn::And(hn::Eq(p.x, q.x), ltY));
+  };
+  // if (less(second, first)) swap(first, second)
+  const auto exchange = [&](Corner* first, Corner* second) {
+    const M m = less(*second, *first);
+    const Corner f = *first, s = *second;
+    first->x = hn::IfThenElse(m, s.x, f.x), second->x = hn::IfThenElse(m, f.x, s.x);
+    first->y = hn::IfThenElse(m, s.y, f.y), second->y = hn::IfThenElse(m, f.y, s.y);
+    first->z = hn::IfThenElse(m, s.z, f.z), second->z = hn::IfThenElse(m, f.z, s.z);
+    first->index = hn::IfThenElse(m, s.index, f.index), second->index = hn::IfThenElse(m, f.index, s.index);
+  };
+  for (size_t i = 0; i < b->lanes; i += N) {
+    Corner k[3];
+    for (int c = 0; c < 3; ++c) {
+      k[c].x = hn::Load(d, b->c[c][0] + i);
+      k[c].y = hn::Load(d, b->c[c][1] + i);
+      k[c].z = hn::Load(d, b->c[c][2] + i);
+      k[c].index = hn::Set(d, double(c));
+    }
+    exchange(&k[0], &k[1]);
+    exchange(&k[1], &k[2]);
+    exchange(&k[0], &k[1]);
+    // The slot (rank) holding stored corner 1, and 2.
+    const auto slotOf = [&](const V& stored) {
+      return hn::IfThenElse(hn::Eq(k[0].index, stored), zero,
+                            hn::IfThenElse(hn::Eq(k[1].index, stored), one, two));
+    };
+    hn::Store(slotOf(one), d, b->slot1 + i);
+    hn::Store(slotOf(two), d, b->slot2 + i);
+    const V e1x = hn::Sub(k[1].x, k[0].x), e1y = hn::Sub(k[1].y, k[0].y), e1z = hn::Sub(k[1].z, k[0].z);
+    const V e2x = hn::Sub(k[2].x, k[0].x), e2y = hn::Sub(k[2].y, k[0].y), e2z = hn::Sub(k[2].z, k[0].z);
+    const V sx = hn::Sub(ex, k[0].x), sy = hn::Sub(ey, k[0].y), sz = hn::Sub(ez, k[0].z);
+    const V qx = hn::Sub(hn::Mul(sy, e1z), hn::Mul(e1y, sz));
+    const V qy = hn::Sub(hn::Mul(sz, e1x), hn::Mul(e1z, sx));
+    const V qz = hn::Sub(hn::Mul(sx, e1y), hn::Mul(e1x, sy));
+    hn::Store(hn::Add(hn::Add(hn::Mul(e2x, qx), hn::Mul(e2y, qy)), hn::Mul(e2z, qz)), d, b->e2DotQ + i);
+    hn::Store(e1x, d, b->e1[0] + i), hn::Store(e1y, d, b->e1[1] + i), hn::Store(e1z, d, b->e1[2] + i);
+    hn::Store(e2x, d, b->e2[0] + i), hn::Store(e2y, d, b->e2[1] + i), hn::Store(e2z, d, b->e2[2] + i);
+    hn::Store(sx, d, b->s[0] + i), hn::Store(sy, d, b->s[1] + i), hn::Store(sz, d, b->s[2] + i);
+    hn::Store(qx, d, b->q[0] + i), hn::Store(qy, d, b->q[1] + i), hn::Store(qz, d, b->q[2] + i);
+  }
+}
+
+size_t PlaneLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace rastray
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+
+#include <algorithm>
+
+#include "common/triangle_plane.h"
+
+namespace rastray {
+
+HWY_EXPORT(LanesRefinePlanes);
+HWY_EXPORT(PlaneLanes);
+
+RefinePlane refinePlaneReference(const Scene& scene, uint32_t instance, uint32_t triangle,
+                                 const glm::dvec3& eye) {
+  // glm: the same bits as intersectTrianglePlane's memo for a ray from eye.
+  const TrianglePlane plane = trianglePlane(scene, instance, triangle);
+  RefinePlane p;
+  p.e1 = plane.e1;
+  p.e2 = plane.e2;
+  p.s = eye - plane.a;
+  p.q = glm::cross(p.s, plane.e1);
+  p.e2DotQ = glm::dot(plane.e2, p.q);
+  p.slot1 = plane.slot1;
+  p.slot2 = plane.slot2;
+  return p;
+}
+
+void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count, const glm::dvec3& eye,
+                  RefinePlane* out) {
+  using setup_planes_detail::kBlock;
+  if (count == 0) return;
+  // Per thread: 12 KB, reused by every chunk the thread sets up.
+  thread_local setup_planes_detail::PlaneBlock block;
+  setup_planes_detail::PlaneBlock& b = block;
+  const double eyeLanes[3] = {eye.x, eye.y, eye.z};
+  const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(PlaneLanes)();
+  for (size_t first = 0; first < count; first += kBlock) {
+    const size_t n = std::min(kBlock, count - first);
+    for (size_t k = 0; k < n; ++k) {
+      const TriangleSetup& t = setups[first + k];
+      const glm::uvec3 v = scene.triangle(t.instance, t.triangle);
+      for (int c = 0; c < 3; ++c) {
+        const glm::vec3& p = scene.positions[v[c]];
+        b.c[c][0][k] = double(p.x), b.c[c][1][k] = double(p.y), b.c[c][2][k] = double(p.z);
+      }
+    }
+    // Padding: the last triangle again, never read back.
+    b.lanes = (n + vectorLanes - 1) / vectorLanes * vectorLanes;
+    for (size_t k = n; k < b.lanes; ++k)
+      for (int c = 0; c < 3; ++c)
+        for (int a = 0; a < 3; ++a) b.c[c][a][k] = b.c[c][a][n - 1];
+    HWY_DYNAMIC_DISPATCH(LanesRefinePlanes)(&b, eyeLanes);
+    for (size_t k = 0; k < n; ++k) {
+      RefinePlane& p = out[first + k];
+      p.e1 = {b.e1[0][k], b.e1[1][k], b.e1[2][k]};
+      p.e2 = {b.e2[0][k], b.e2[1][k], b.e2[2][k]};
+      p.s = {b.s[0][k], b.s[1][k], b.s[2][k]};
+      p.q = {b.q[0][k], b.q[1][k], b.q[2][k]};
+      p.e2DotQ = b.e2DotQ[k];
+      p.slot1 = int32_t(b.slot1[k]);
+      p.slot2 = int32_t(b.slot2[k]);
+    }
+  }
+}
+
+}  // namespace rastray
+
+#endif  // HWY_ONCE
