@@ -388,11 +388,11 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
                   }
                   // Eight bits counted in registers (the build has no
                   // POPCNT: __builtin_popcount is a library call).
-                  uint32_t n = passMask - ((passMask >> 1) & 0x55u);
-                  n = (n & 0x33u) + ((n >> 2) & 0x33u);
-                  n = (n + (n >> 4)) & 0x0Fu;
-                  counters->samplesPassed += n;
-                  written += n;
+                  uint32_t passed = passMask - ((passMask >> 1) & 0x55u);
+                  passed = (passed & 0x33u) + ((passed >> 2) & 0x33u);
+                  passed = (passed + (passed >> 4)) & 0x0Fu;
+                  counters->samplesPassed += passed;
+                  written += passed;
                   continue;
                 }
               }
