@@ -30,6 +30,19 @@ glm::vec3 world(double x, double y, double z) {
 }
 
 // A random scene of `count` triangles of mixed kinds.
+// Two triangles per cell of a cells × cells grid whose (cells + 1)²
+// vertices are numbered row by row.
+std::vector<glm::uvec3> gridTriangles(int cells) {
+  std::vector<glm::uvec3> t;
+  for (int y = 0; y < cells; ++y)
+    for (int x = 0; x < cells; ++x) {
+      const uint32_t a = uint32_t(y * (cells + 1) + x);
+      t.push_back({a, a + 1, a + uint32_t(cells) + 2});
+      t.push_back({a, a + uint32_t(cells) + 2, a + uint32_t(cells) + 1});
+    }
+  return t;
+}
+
 Scene randomScene(uint32_t seed, int count) {
   std::mt19937 rng(seed);
   const auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
@@ -237,18 +250,12 @@ TEST(CoverageEquivalence, ClearedRectsGiveTheSameTargetAndCounters) {
   // A 60 × 60 grid of quads, two triangles each, about 2.5 pixels a
   // triangle, in front of the random scene's triangles.
   std::vector<glm::vec3> p;
-  std::vector<glm::uvec3> t;
   constexpr int kCells = 60;
   const double cell = double(kSize) / kCells;
   for (int y = 0; y <= kCells; ++y)
     for (int x = 0; x <= kCells; ++x)
       p.push_back(world(x * cell, y * cell, -1.0 - 0.001 * ((x * 7 + y * 3) % 11)));
-  for (int y = 0; y < kCells; ++y)
-    for (int x = 0; x < kCells; ++x) {
-      const uint32_t a = uint32_t(y * (kCells + 1) + x);
-      t.push_back({a, a + 1, a + uint32_t(kCells) + 2});
-      t.push_back({a, a + uint32_t(kCells) + 2, a + uint32_t(kCells) + 1});
-    }
+  const std::vector<glm::uvec3> t = gridTriangles(kCells);
   test::addMesh(scene, p, t);
   const Scene behind = randomScene(5, 60);
   test::addPushedBehind(scene, behind, -2.0f);
@@ -298,16 +305,10 @@ TEST(CoverageEquivalence, SmallTrianglePathWritesTheReferenceKeysAndWinners) {
   for (const double cell : {1.1, 2.3}) {
     const int cells = int(kSize / cell);
     std::vector<glm::vec3> p;
-    std::vector<glm::uvec3> t;
     for (int y = 0; y <= cells; ++y)
       for (int x = 0; x <= cells; ++x)
         p.push_back(world(x * cell + 0.3, y * cell + 0.1, -1.0 - uniform(0.0, 0.05)));
-    for (int y = 0; y < cells; ++y)
-      for (int x = 0; x < cells; ++x) {
-        const uint32_t a = uint32_t(y * (cells + 1) + x);
-        t.push_back({a, a + 1, a + uint32_t(cells) + 2});
-        t.push_back({a, a + uint32_t(cells) + 2, a + uint32_t(cells) + 1});
-      }
+    std::vector<glm::uvec3> t = gridTriangles(cells);
     test::addMesh(scene, p, t);
     t.resize(t.size() / 3);
     test::addMesh(scene, p, t);  // the copy: exact ties
