@@ -299,6 +299,27 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
       ++written;
       writtenMax = std::max(writtenMax, key);
     };
+    // The samples of one block set in its per-sample masks (bit 8·y + x
+    // from the block's corner x0, y0), tested sample by sample in bit
+    // order; the block's hierarchical bound learns what was written.
+    const auto testMaskedSamples = [&](int x0, int y0, const uint64_t* sampleMasks, size_t hb)
+        __attribute__((always_inline)) {
+      uint32_t written = 0, writtenMax = 0;
+      for (int s = 0; s < spp; ++s) {
+        uint64_t m = sampleMasks[s];
+        counters->samplesTested += uint64_t(bitCount(m));
+        while (m) {
+          const int bit = __builtin_ctzll(m);
+          m &= m - 1;
+          const int px = x0 + (bit & 7), py = y0 + (bit >> 3);
+          testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s), written, writtenMax);
+        }
+      }
+      if (written != 0) {
+        bounds.addWrites(hb, written);
+        bounds.markStale(hb);
+      }
+    };
     constexpr int B = kCoverageBlock;
     const int w = r.x1 - r.x0 + 1, h = r.y1 - r.y0 + 1;
     if ((r.x0 - rect.x0) / B == (r.x1 - rect.x0) / B && (r.y0 - rect.y0) / B == (r.y1 - rect.y0) / B &&
@@ -333,21 +354,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
       const PixelBlock b{r.x0, r.y0, w, h};
       const size_t hb = bounds.block(r.x0, r.y0);
       if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
-      uint32_t written = 0, writtenMax = 0;
-      for (int k = 0; k < spp; ++k) {
-        uint64_t m = smallMasks[k];
-        counters->samplesTested += uint64_t(bitCount(m));
-        while (m) {
-          const int bit = __builtin_ctzll(m);
-          m &= m - 1;
-          const int px = r.x0 + (bit & 7), py = r.y0 + (bit >> 3);
-          testKey(px, py, k, sampleDepthKey(t, grid, format, px, py, k), written, writtenMax);
-        }
-      }
-      if (written != 0) {
-        bounds.addWrites(hb, written);
-        bounds.markStale(hb);
-      }
+      testMaskedSamples(r.x0, r.y0, smallMasks, hb);
       continue;
     }
     prepareOffsets(t, grid, scratch);
@@ -408,20 +415,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
           continue;
         }
         blockMasks(t, scratch, U, spp, b, lo, masks);
-        for (int s = 0; s < spp; ++s) {
-          uint64_t m = masks[s];
-          counters->samplesTested += uint64_t(bitCount(m));
-          while (m) {
-            const int bit = __builtin_ctzll(m);
-            m &= m - 1;
-            const int px = b.x + (bit & 7), py = b.y + (bit >> 3);
-            testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s), written, writtenMax);
-          }
-        }
-        if (written != 0) {
-          bounds.addWrites(hb, written);
-          bounds.markStale(hb);
-        }
+        testMaskedSamples(b.x, b.y, masks, hb);
       }
   }
 }
