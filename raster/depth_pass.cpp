@@ -2,8 +2,11 @@
 //
 // The fast path walks each triangle block by block (block_coverage.h) and
 // tests the covered samples of a block from its masks; a block the
-// triangle covers whole takes its keys a block row at a time, eight in
-// SIMD doubles (depth_keys.h, the same bits). In front of that, a
+// triangle covers whole, eight pixels wide, is tested and written in SIMD
+// lanes at float formats without an alpha test (depth_lanes.h: every
+// entry of its rows a vector at a time, the same bits, ties handed back
+// to the id rule here); other whole blocks take their keys a block row at
+// a time, eight in SIMD doubles (depth_keys.h, the same bits). In front of that, a
 // hierarchical depth test per block of the rect: an upper bound of the
 // keys stored in the block against a lower bound of the triangle's keys
 // there; a block where the triangle is behind everything stored is skipped
@@ -21,6 +24,7 @@
 #include "raster/coverage.h"
 #include "raster/depth_bounds.h"
 #include "raster/depth_keys.h"
+#include "raster/depth_lanes.h"
 
 namespace rastray {
 
@@ -194,6 +198,29 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     lowPos = glm::min(lowPos, q);
     highPos = glm::max(highPos, q);
   }
+  // Whole covered blocks eight pixels wide go to the lanes (depth_lanes.h)
+  // at float formats without an alpha test; their per-entry pixel offsets
+  // and sample positions, a block row's 8·spp entries in target order.
+  const bool blockLanes =
+      !alphaTest && (format == DepthFormat::FloatReversed || format == DepthFormat::Float);
+  std::vector<double> entries;
+  DepthBlockLanes lanes;
+  uint8_t coverBits[kCoverageBlock * 8];  // a partial block's entry bits, up to 8 spp
+  if (blockLanes) {
+    const size_t n = size_t(kCoverageBlock) * size_t(spp);
+    entries.resize(3 * n);
+    for (size_t j = 0; j < n; ++j) {
+      entries[j] = double(j / size_t(spp));
+      entries[n + j] = grid.positions[j % size_t(spp)].x;
+      entries[2 * n + j] = grid.positions[j % size_t(spp)].y;
+    }
+    lanes.spp = spp;
+    lanes.entryPixel = entries.data();
+    lanes.entryX = entries.data() + n;
+    lanes.entryY = entries.data() + 2 * n;
+    lanes.reversed = format == DepthFormat::FloatReversed;
+    lanes.rowStride = size_t(target->width) * size_t(spp);
+  }
 
   // The depth test and write of t at one sample, traced when asked (the
   // reference and traced walks).
@@ -320,6 +347,37 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         bounds.markStale(hb);
       }
     };
+    // Block b (eight pixels wide) in lanes (depth_lanes.h): the samples
+    // set in `masks` (per sample, as testMaskedSamples), or every sample
+    // when masks is nullptr; `cover` the same as the lanes' entry bits. A
+    // vector with a tie comes back, its covered entries tested here.
+    const auto testLanes = [&](const PixelBlock& b, const uint64_t* masks, const uint8_t* cover,
+                               uint32_t& written, uint32_t& writtenMax) {
+      lanes.v0 = t.depth.v0, lanes.dx = t.depth.dx, lanes.dy = t.depth.dy;
+      lanes.x0 = t.depth.x0, lanes.y0 = t.depth.y0;
+      lanes.x = b.x, lanes.y = b.y, lanes.rows = b.h;
+      lanes.index = index;
+      lanes.cover = cover;
+      const size_t first = target->index(b.x, b.y, 0);
+      lanes.keys = keys + first;
+      lanes.winners = keysOnly ? nullptr : winners + first;
+      DepthBlockTally tally;
+      size_t width = 1;
+      for (size_t v = 0;; ++v) {
+        v = depthBlockLanes(lanes, v, &width, &tally);
+        const size_t perRow = size_t(kCoverageBlock * spp) / width;
+        if (v >= perRow * size_t(b.h)) break;
+        const int j = int(v / perRow), py = b.y + j;
+        for (size_t e = v % perRow * width, end = e + width; e < end; ++e) {
+          const int i = int(e / size_t(spp)), s = int(e % size_t(spp)), px = b.x + i;
+          if (masks && !(masks[s] >> (8 * j + i) & 1u)) continue;
+          testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s), written, writtenMax);
+        }
+      }
+      counters->samplesPassed += tally.written;
+      written += tally.written;
+      writtenMax = std::max(writtenMax, tally.writtenMax);
+    };
     constexpr int B = kCoverageBlock;
     const int w = r.x1 - r.x0 + 1, h = r.y1 - r.y0 + 1;
     if ((r.x0 - rect.x0) / B == (r.x1 - rect.x0) / B && (r.y0 - rect.y0) / B == (r.y1 - rect.y0) / B &&
@@ -371,39 +429,46 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
         uint32_t written = 0, writtenMax = 0;
         if (c == BlockClass::Accept) {
-          // Every sample covered: each block row's keys eight at a time
-          // (depth_keys.h: the bits of sampleDepthKey), then tested.
           counters->samplesTested += uint64_t(b.w) * uint64_t(b.h) * uint64_t(spp);
-          for (int s = 0; s < spp; ++s) {
-            const glm::dvec2& q = grid.positions[size_t(s)];
-            double column[8];
-            planeColumnTerms(t.depth, b.x, q.x, column);
-            for (int py = b.y; py < b.y + b.h; ++py) {
-              uint32_t rowKeys[8];
-              planeRowKeys(format, column, planeRowTerm(t.depth, py, q.y), rowKeys);
-              if (spp == 1 && b.w == 8 && !alphaTest && !keysOnly) {
-                // The row's eight samples are contiguous: compared at once,
-                // unless a key ties its stored one (the id rule decides).
-                const size_t i = target->index(b.x, py, 0);
-                uint32_t passMask = 0;
-                if (rowLess(rowKeys, keys + i, &passMask)) {
-                  for (int k = 0; k < 8; ++k) {
-                    if (!(passMask >> k & 1u)) continue;
-                    keys[i + size_t(k)] = rowKeys[k];
-                    winners[i + size_t(k)] = index;
-                    writtenMax = std::max(writtenMax, rowKeys[k]);
+          if (blockLanes && b.w == B) {
+            // Every sample covered, eight pixels wide: the block's keys
+            // tested and written in lanes, vector by vector; a vector with a
+            // tie comes back here, its entries tested one by one.
+            testLanes(b, nullptr, nullptr, written, writtenMax);
+          } else {
+            // Every sample covered: each block row's keys eight at a time
+            // (depth_keys.h: the bits of sampleDepthKey), then tested.
+            for (int s = 0; s < spp; ++s) {
+              const glm::dvec2& q = grid.positions[size_t(s)];
+              double column[8];
+              planeColumnTerms(t.depth, b.x, q.x, column);
+              for (int py = b.y; py < b.y + b.h; ++py) {
+                uint32_t rowKeys[8];
+                planeRowKeys(format, column, planeRowTerm(t.depth, py, q.y), rowKeys);
+                if (spp == 1 && b.w == 8 && !alphaTest && !keysOnly) {
+                  // The row's eight samples are contiguous: compared at once,
+                  // unless a key ties its stored one (the id rule decides).
+                  const size_t i = target->index(b.x, py, 0);
+                  uint32_t passMask = 0;
+                  if (rowLess(rowKeys, keys + i, &passMask)) {
+                    for (int k = 0; k < 8; ++k) {
+                      if (!(passMask >> k & 1u)) continue;
+                      keys[i + size_t(k)] = rowKeys[k];
+                      winners[i + size_t(k)] = index;
+                      writtenMax = std::max(writtenMax, rowKeys[k]);
+                    }
+                    // Eight bits counted in registers (the build has no
+                    // POPCNT: __builtin_popcount is a library call).
+                    uint32_t passed = passMask - ((passMask >> 1) & 0x55u);
+                    passed = (passed & 0x33u) + ((passed >> 2) & 0x33u);
+                    passed = (passed + (passed >> 4)) & 0x0Fu;
+                    counters->samplesPassed += passed;
+                    written += passed;
+                    continue;
                   }
-                  // Eight bits counted in registers (the build has no
-                  // POPCNT: __builtin_popcount is a library call).
-                  uint32_t passed = passMask - ((passMask >> 1) & 0x55u);
-                  passed = (passed & 0x33u) + ((passed >> 2) & 0x33u);
-                  passed = (passed + (passed >> 4)) & 0x0Fu;
-                  counters->samplesPassed += passed;
-                  written += passed;
-                  continue;
                 }
+                for (int k = 0; k < b.w; ++k) testKey(b.x + k, py, s, rowKeys[k], written, writtenMax);
               }
-              for (int k = 0; k < b.w; ++k) testKey(b.x + k, py, s, rowKeys[k], written, writtenMax);
             }
           }
           if (written == 0) continue;
@@ -415,6 +480,30 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
           continue;
         }
         blockMasks(t, scratch, U, spp, b, lo, masks);
+        if (blockLanes && b.w == B && spp <= 8) {
+          // The lanes' entry bits: row j's 8·spp bits, pixel-major (the
+          // masks' own layout at 1 spp).
+          const uint8_t* cover = reinterpret_cast<const uint8_t*>(masks);
+          if (spp > 1) {
+            for (int j = 0; j < b.h; ++j) {
+              uint64_t row = 0;
+              for (int s = 0; s < spp; ++s)
+                for (uint64_t m = masks[s] >> (8 * j) & 0xFFu; m; m &= m - 1)
+                  row |= uint64_t(1) << (__builtin_ctzll(m) * spp + s);
+              for (int k = 0; k < spp; ++k) coverBits[size_t(j * spp + k)] = uint8_t(row >> (8 * k));
+            }
+            cover = coverBits;
+          }
+          uint32_t tested = 0;
+          for (int s = 0; s < spp; ++s) tested += uint32_t(bitCount(masks[s]));
+          counters->samplesTested += tested;
+          testLanes(b, masks, cover, written, writtenMax);
+          if (written != 0) {
+            bounds.addWrites(hb, written);
+            bounds.markStale(hb);
+          }
+          continue;
+        }
         testMaskedSamples(b.x, b.y, masks, hb);
       }
   }

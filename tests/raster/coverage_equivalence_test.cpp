@@ -5,6 +5,7 @@
 // shared edges (fill-rule ties) and coplanar duplicates (depth-key ties).
 #include <gtest/gtest.h>
 
+#include <hwy/targets.h>
 #include <random>
 #include <tuple>
 
@@ -157,15 +158,17 @@ struct PassResult {
 
 // Two depth passes over every tile (the first half of the setups, then the
 // rest, so the second starts from a filled target), with a MASK-like
-// alpha test that drops a hashed subset of the samples of odd instances.
+// alpha test that drops a hashed subset of the samples of odd instances
+// (unless `mask` is false).
 PassResult depthPass(const std::vector<TriangleSetup>& setups, const SampleGrid& grid, DepthFormat format,
-                     DepthFunc func, bool keysOnly, CoveragePath path) {
+                     DepthFunc func, bool keysOnly, CoveragePath path, bool mask = true) {
   PassResult r{DepthTarget(kSize, kSize, grid.spp, keysOnly), {}};
-  const std::function<bool(const TriangleSetup&, int, int, int)> alpha = [](const TriangleSetup& t, int x,
-                                                                            int y, int s) {
-    return t.instance % 2 == 0 ||
-           ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ uint32_t(s) ^ t.triangle) % 5 != 0;
-  };
+  std::function<bool(const TriangleSetup&, int, int, int)> alpha;
+  if (mask)
+    alpha = [](const TriangleSetup& t, int x, int y, int s) {
+      return t.instance % 2 == 0 ||
+             ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ uint32_t(s) ^ t.triangle) % 5 != 0;
+    };
   const TileGrid tiles(kSize, kSize);
   const size_t half = setups.size() / 2;
   for (const auto& [from, to] : {std::pair<size_t, size_t>{0, half}, {half, setups.size()}}) {
@@ -218,6 +221,46 @@ TEST(CoverageEquivalence, FastDepthPassWritesTheReferenceKeysAndWinners) {
             }
         }
   }
+}
+
+// The depth pass's lanes (depth_lanes.h: blocks eight pixels wide, whole
+// or partial, at float formats without MASK) against the reference walk
+// on every Highway target the build has: large random triangles among
+// small ones, and two tilted quads over the whole image each with a
+// coplanar copy (exact key ties over whole blocks, decided by id: the
+// lanes hand those vectors back), at 1, 4 and 8 spp (partial blocks take
+// the lanes up to 8 spp), both float formats, both functions, keys only.
+RASTRAY_TEST_LABELS_OF(CoverageEquivalence, BlockLanesWriteTheReferenceKeysAndWinners, "quick");
+TEST(CoverageEquivalence, BlockLanesWriteTheReferenceKeysAndWinners) {
+  Scene scene = randomScene(23, 40);
+  for (const double z : {-4.0, -6.0}) {
+    const std::vector<glm::vec3> p = {world(-3, -2, z - 1.5), world(kSize + 4, -2, z),
+                                      world(kSize + 4, kSize + 3, z + 1.0), world(-3, kSize + 3, z - 0.5)};
+    for (int copy = 0; copy < 2; ++copy) test::addMesh(scene, p, {{0, 1, 2}, {0, 2, 3}});
+  }
+  const Camera persp =
+      test::perspectiveCamera(kSize, kSize, 1.2, glm::dvec3(2, -1, 70), glm::dvec3(0, 0, 0), 0.5);
+  for (const int spp : {1, 4, 8})
+    for (const DepthFormat format : {DepthFormat::FloatReversed, DepthFormat::Float}) {
+      const SampleGrid grid = makeSampleGrid(spp, kSize, kSize);
+      const auto setups = setupScene(scene, persp, grid, format);
+      for (const DepthFunc func : {DepthFunc::Less, DepthFunc::LEqual})
+        for (const bool keysOnly : {false, true}) {
+          if (keysOnly && func == DepthFunc::LEqual) continue;
+          const PassResult slow =
+              depthPass(setups, grid, format, func, keysOnly, CoveragePath::Reference, false);
+          for (const int64_t simd : hwy::SupportedAndGeneratedTargets()) {
+            hwy::SetSupportedTargetsForTest(simd);
+            const PassResult fast =
+                depthPass(setups, grid, format, func, keysOnly, CoveragePath::Fast, false);
+            const std::string what = "spp " + std::to_string(spp) + " " + toString(format) + " " +
+                                     toString(func) + (keysOnly ? " keys only " : " ") +
+                                     hwy::TargetName(simd);
+            ASSERT_NO_FATAL_FAILURE(expectSamePass(fast, slow, what));
+          }
+          hwy::SetSupportedTargetsForTest(0);
+        }
+    }
 }
 
 TEST(CoverageEquivalence, HierarchicalDepthSkipsOccludedBlocks) {
