@@ -25,7 +25,6 @@ size_t LanesDepthBlock(const DepthBlockLanes& b, size_t from, size_t* lanes, Dep
   const size_t N = hn::Lanes(dd);
   static_assert(hn::MaxLanes(decltype(dd)()) <= 8, "a vector's cover bits within one byte");
   *lanes = N;
-  const size_t perRow = size_t(8 * b.spp) / N;
   const auto v0 = hn::Set(dd, b.v0), dx = hn::Set(dd, b.dx), dy = hn::Set(dd, b.dy);
   const auto x0 = hn::Set(dd, b.x0), y0 = hn::Set(dd, b.y0), px = hn::Set(dd, double(b.x));
   const auto zero = hn::Zero(dd), one = hn::Set(dd, 1.0);
@@ -42,36 +41,41 @@ size_t LanesDepthBlock(const DepthBlockLanes& b, size_t from, size_t* lanes, Dep
     }
     return v;
   };
-  const size_t rowEntries = size_t(8 * b.spp);
+  const size_t rowEntries = size_t(8 * b.spp), rows = size_t(b.rows);
+  // Vector v is entries [k·N, k·N + N) of row j, v = k·rows + j: a
+  // column of vectors shares its column terms.
   size_t v = from;
-  for (size_t row = from / perRow, e = from % perRow * N; row < size_t(b.rows); ++row, e = 0) {
-    const auto y = hn::Set(dd, double(b.y + int(row)));
-    uint32_t* keyRow = b.keys + row * b.rowStride;
-    uint32_t* winnerRow = b.winners != nullptr ? b.winners + row * b.rowStride : nullptr;
-    for (; e < rowEntries; e += N, ++v) {
-      // (v0 + dx·((px + ox) − x0)) + dy·((py + oy) − y0): Plane::at's operations in its order.
-      const auto x = hn::Add(hn::Add(px, hn::LoadU(dd, b.entryPixel + e)), hn::LoadU(dd, b.entryX + e));
-      const auto z = hn::Add(hn::Add(v0, hn::Mul(dx, hn::Sub(x, x0))),
-                             hn::Mul(dy, hn::Sub(hn::Add(y, hn::LoadU(dd, b.entryY + e)), y0)));
+  for (size_t k = from / rows, j = from % rows; k * N < rowEntries; ++k, j = 0) {
+    const size_t e = k * N;
+    // Plane::at's operations in its order: (v0 + dx·((px + ox) − x0)) + dy·((py + oy) − y0).
+    const auto x = hn::Add(hn::Add(px, hn::LoadU(dd, b.entryPixel + e)), hn::LoadU(dd, b.entryX + e));
+    const auto column = hn::Add(v0, hn::Mul(dx, hn::Sub(x, x0)));
+    const auto oy = hn::LoadU(dd, b.entryY + e);
+    uint32_t* keyColumn = b.keys + e;
+    uint32_t* winnerColumn = b.winners != nullptr ? b.winners + e : nullptr;
+    for (; j < rows; ++j, ++v) {
+      const auto z =
+          hn::Add(column, hn::Mul(dy, hn::Sub(hn::Add(hn::Set(dd, double(b.y + int(j))), oy), y0)));
       // std::clamp(z, 0, 1): z < 0 ? 0 : (1 < z ? 1 : z).
       const auto low = hn::IfThenElse(hn::Lt(z, zero), zero, z);
       const auto clamped = hn::IfThenElse(hn::Lt(one, low), one, low);
       const auto bits = hn::BitCast(du, hn::DemoteTo(df, clamped));
       const auto key = b.reversed ? hn::Sub(oneBits, bits) : bits;
-      const auto stored = hn::LoadU(du, keyRow + e);
+      uint32_t* keys = keyColumn + j * b.rowStride;
+      const auto stored = hn::LoadU(du, keys);
       auto pass = hn::Lt(key, stored);
       auto tie = hn::Eq(key, stored);
       if (b.cover != nullptr) {
-        const size_t k = row * rowEntries + e;  // the vector's first bit (N <= 8 lanes: one byte)
-        const uint8_t coverByte = uint8_t(b.cover[k / 8] >> (k % 8));
+        const size_t bit = j * rowEntries + e;  // the vector's first bit (N <= 8 lanes: one byte)
+        const uint8_t coverByte = uint8_t(b.cover[bit / 8] >> (bit % 8));
         const auto covered = hn::LoadMaskBits(du, &coverByte);
         pass = hn::And(pass, covered);
         tie = hn::And(tie, covered);
       }
       // A tie: the id rule decides, on the caller's side (keys only: fails).
-      if (winnerRow != nullptr && !hn::AllFalse(du, tie)) return finish(v);
-      hn::BlendedStore(key, pass, du, keyRow + e);
-      if (winnerRow != nullptr) hn::BlendedStore(index, pass, du, winnerRow + e);
+      if (winnerColumn != nullptr && !hn::AllFalse(du, tie)) return finish(v);
+      hn::BlendedStore(key, pass, du, keys);
+      if (winnerColumn != nullptr) hn::BlendedStore(index, pass, du, winnerColumn + j * b.rowStride);
       written += uint32_t(hn::CountTrue(du, pass));
       largest = hn::Max(largest, hn::IfThenElseZero(pass, key));
     }

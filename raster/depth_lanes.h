@@ -52,11 +52,12 @@ struct DepthBlockTally {
   uint32_t written = 0, writtenMax = 0;
 };
 
-// Tests and writes the block's covered entries, vectors from number `from` on (a row holds
-// 8·spp / lanes of them, numbered row by row; `*lanes` receives the
-// entries per vector) up to the first one with a tie (not written at
-// all): returns its number, or the block's vector count when every
-// vector from `from` on was done. Adds what it wrote to `tally`.
+// Tests and writes the block's covered entries, vectors from number `from`
+// on (entries [k·lanes, (k + 1)·lanes) of pixel row j are vector
+// k·rows + j; `*lanes` receives the entries per vector) up to the first
+// one with a tie (not written at all): returns its number, or the block's
+// vector count when every vector from `from` on was done. Adds what it
+// wrote to `tally`.
 size_t depthBlockLanes(const DepthBlockLanes& block, size_t from, size_t* lanes, DepthBlockTally* tally);
 
 // The entries per vector of the target depthBlockLanes runs on (for

@@ -365,10 +365,9 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
       size_t width = 1;
       for (size_t v = 0;; ++v) {
         v = depthBlockLanes(lanes, v, &width, &tally);
-        const size_t perRow = size_t(kCoverageBlock * spp) / width;
-        if (v >= perRow * size_t(b.h)) break;
-        const int j = int(v / perRow), py = b.y + j;
-        for (size_t e = v % perRow * width, end = e + width; e < end; ++e) {
+        if (v >= size_t(kCoverageBlock * spp) / width * size_t(b.h)) break;
+        const int j = int(v % size_t(b.h)), py = b.y + j;
+        for (size_t e = v / size_t(b.h) * width, end = e + width; e < end; ++e) {
           const int i = int(e / size_t(spp)), s = int(e % size_t(spp)), px = b.x + i;
           if (masks && !(masks[s] >> (8 * j + i) & 1u)) continue;
           testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s), written, writtenMax);
