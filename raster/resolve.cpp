@@ -28,18 +28,35 @@ void LanesLeanRow1(const float* color, const float* depthIn, const uint32_t* win
   const size_t N = hn::Lanes(df);
   const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
   const SampleHit none;
+  const auto noSetup = hn::Set(du, kNoSetup);
+  // Colour vector k of N pixels holds pixels k·N/4 + lane/4: the winners'
+  // lanes to repeat across each pixel's four channels.
+  const auto quarter = hn::ShiftRight<2>(hn::Iota(du, 0));
   size_t i = 0;
   for (; i + N <= width; i += N) {
     const uint32_t first = winners[i];
-    if (!hn::AllTrue(du, hn::Eq(hn::LoadU(du, winners + i), hn::Set(du, first)))) {
+    const auto w = hn::LoadU(du, winners + i);
+    if (!hn::AllTrue(du, hn::Eq(w, hn::Set(du, first)))) {
+      // Mixed: colour and depth in lanes (0 + (covered ? c : 0); x / 1
+      // is x after the sum), the ids per pixel from the setups.
+      for (size_t k = 0; k < 4; ++k) {
+        const auto idx = hn::IndicesFromVec(du, hn::Add(quarter, hn::Set(du, uint32_t(k * N / 4))));
+        const auto covered = hn::RebindMask(df, hn::Ne(hn::TableLookupLanes(w, idx), noSetup));
+        hn::StoreU(hn::Add(zero, hn::IfThenElseZero(covered, hn::LoadU(df, color + 4 * i + k * N))), df,
+                   colorOut + 4 * i + k * N);
+      }
+      hn::StoreU(hn::IfThenElse(hn::RebindMask(df, hn::Ne(w, noSetup)), hn::LoadU(df, depthIn + i),
+                                hn::Set(df, none.depth)),
+                 df, depthOut + i);
+      uint32_t last = kNoSetup, instance = none.instance, triangle = none.triangle;
       for (size_t j = i; j < i + N; ++j) {
-        const uint32_t w = winners[j];
-        const bool covered = w != kNoSetup;
-        for (size_t k = 0; k < 4; ++k)
-          colorOut[4 * j + k] = (0.0f + (covered ? color[4 * j + k] : 0.0f)) / 1.0f;
-        depthOut[j] = covered ? depthIn[j] : none.depth;
-        instanceOut[j] = covered ? setups[w].instance : none.instance;
-        triangleOut[j] = covered ? setups[w].triangle : none.triangle;
+        if (winners[j] != last) {
+          last = winners[j];
+          instance = last == kNoSetup ? none.instance : setups[last].instance;
+          triangle = last == kNoSetup ? none.triangle : setups[last].triangle;
+        }
+        instanceOut[j] = instance;
+        triangleOut[j] = triangle;
       }
       continue;
     }
