@@ -479,7 +479,12 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
           continue;
         }
         blockMasks(t, scratch, U, spp, b, lo, masks);
-        if (blockLanes && b.w == B && spp <= 8) {
+        uint32_t covered = 0;
+        if (blockLanes && b.w == B && spp <= 8)
+          for (int s = 0; s < spp; ++s) covered += uint32_t(bitCount(masks[s]));
+        // The lanes where the block's rows hold two covered pixels a row
+        // on average (a vector costs about what a sample costs alone).
+        if (covered != 0 && covered >= uint32_t(2 * b.h * spp)) {
           // The lanes' entry bits: row j's 8·spp bits, pixel-major (the
           // masks' own layout at 1 spp).
           const uint8_t* cover = reinterpret_cast<const uint8_t*>(masks);
@@ -493,9 +498,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
             }
             cover = coverBits;
           }
-          uint32_t tested = 0;
-          for (int s = 0; s < spp; ++s) tested += uint32_t(bitCount(masks[s]));
-          counters->samplesTested += tested;
+          counters->samplesTested += covered;
           testLanes(b, masks, cover, written, writtenMax);
           if (written != 0) {
             bounds.addWrites(hb, written);
