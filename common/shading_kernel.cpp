@@ -531,8 +531,11 @@ class BlockShader {
     LaneBlock& b = block_;
     colourPerLane();
     const size_t i = b.used++;
-    outputs_[i] = out;
-    contiguous_ = contiguous_ && (i == 0 || out == outputs_[i - 1] + 1);
+    if (i == 0) base_ = out;
+    if (!contiguous_ || out != base_ + i) {
+      noLongerContiguous(i);
+      outputs_[i] = out;
+    }
     // Consecutive hits mostly share a triangle: its data is looked up once
     // per run (the same values, so the lane does not depend on the run).
     enterRun(h.instance, h.triangle, m);
@@ -631,14 +634,23 @@ class BlockShader {
       std::fill_n(b.emitB + i0, n, b.runEmitB[r]);
       std::fill_n(b.alpha + i0, n, b.runAlpha[r]);
     }
-    bool contiguous = contiguous_ && (i0 == 0 || &colors[h.colorIndex[first]] == outputs_[i0 - 1] + 1);
+    // The run's outputs: consecutive pixels continuing the block's are
+    // not stored lane by lane (base_ + lane gives them).
     const uint32_t c0 = h.colorIndex[first];
-    for (size_t k = 0; k < n; ++k) {
-      const uint32_t c = h.colorIndex[first + k];
-      outputs_[i0 + k] = &colors[c];
-      contiguous = contiguous && c == c0 + uint32_t(k);
-    }
-    contiguous_ = contiguous;
+    if (i0 == 0) base_ = &colors[c0];
+    uint32_t apart = 0;  // nonzero when some output is not c0 + k
+    for (size_t k = 0; k < n; ++k) apart |= h.colorIndex[first + k] ^ (c0 + uint32_t(k));
+    if (contiguous_ && apart == 0 && &colors[c0] == base_ + i0) return;
+    noLongerContiguous(i0);
+    for (size_t k = 0; k < n; ++k) outputs_[i0 + k] = &colors[h.colorIndex[first + k]];
+  }
+
+  // The block's outputs stop being consecutive at lane i: lanes [0, i)
+  // get their outputs_ entries from base_ (kept consecutive until now).
+  void noLongerContiguous(size_t i) {
+    if (!contiguous_) return;
+    for (size_t k = 0; k < i; ++k) outputs_[k] = base_ + k;
+    contiguous_ = false;
   }
 
   // Shades the gathered lanes and writes their colours; empties the block.
@@ -691,7 +703,7 @@ class BlockShader {
     if (contiguous_) {
       // The lanes' colours go to consecutive pixels (a run of samples
       // along a tile row): written interleaved in lanes.
-      HWY_DYNAMIC_DISPATCH(LanesStoreColors)(&b, &outputs_[0]->x);
+      HWY_DYNAMIC_DISPATCH(LanesStoreColors)(&b, &base_->x);
     } else {
       for (size_t i = 0; i < b.used; ++i)
         *outputs_[i] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
@@ -830,8 +842,11 @@ class BlockShader {
   // constructed: only entries whose key is set are read.
   std::unique_ptr<unsigned char[]> runCache_{new unsigned char[sizeof(TriangleRun) << kRunCacheBits]};
   LaneBlock block_;
+  // Where each lane's colour goes: base_ + i for every used lane i while
+  // contiguous_ (outputs_ then unset), else outputs_[i].
   glm::vec4* outputs_[kBlock];
-  bool contiguous_ = true;       // outputs_[i] == outputs_[0] + i for every used lane
+  glm::vec4* base_ = nullptr;
+  bool contiguous_ = true;
   SurfacePoint points_[kBlock];  // set where textured or lit with a visibility callback
   // One light's lit lanes, for LightVisibility::transmittances.
   const SurfacePoint* litPoints_[kBlock];
