@@ -21,4 +21,11 @@ struct TrianglePlane {
 // bit (the same per-thread memo).
 TrianglePlane trianglePlane(const Scene& scene, uint32_t instance, uint32_t triangle);
 
+// The unit face normal of a stored triangle from its corners p_i =
+// dvec3(scene.positions[corner i]) (CCW front; (0, 0, 1) when degenerate):
+// triangleFaceNormal's bits (common/surface.h), without its memo. For
+// callers that hold the corners already (raster setup stores it per setup
+// for the shading kernel).
+glm::dvec3 faceNormalOfCorners(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2);
+
 }  // namespace rastray
