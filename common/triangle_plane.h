@@ -1,7 +1,8 @@
-// Internal to common/: the canonical plane data of a stored triangle that
+// The canonical plane data of a stored triangle that
 // intersectTrianglePlane (common/surface.h) intersects rays with, for the
-// shading kernel's batched refinement (common/primary_refinement.h), which
-// must give intersectTrianglePlane's bits.
+// shading kernel's batched refinement (common/primary_refinement.h) and
+// raster setup's refinement planes (raster/setup.h), which must give
+// intersectTrianglePlane's bits; and the face normal without its memo.
 #pragma once
 
 #include <cstdint>
