@@ -606,7 +606,7 @@ class BlockShader {
     }
     LaneBlock& b = block_;
     const int32_t hitRun = h.run[first];
-    if (h.runCorners && h.runCorners[hitRun].x != kNoId)
+    if (h.runCorners && h.runFaceNormal && h.runCorners[hitRun].x != kNoId)
       enterRun(instance, triangle, m, &h.runCorners[hitRun], &h.runFaceNormal[hitRun]);
     else
       enterRun(instance, triangle, m);
