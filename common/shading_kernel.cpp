@@ -608,7 +608,11 @@ class BlockShader {
       return;
     }
     LaneBlock& b = block_;
-    enterRun(instance, triangle, m);
+    const int32_t hitRun = h.run[first];
+    if (h.runCorners && h.runFaceNormal && h.runCorners[hitRun].x != kNoId)
+      enterRun(instance, triangle, m, &h.runCorners[hitRun], &h.runFaceNormal[hitRun]);
+    else
+      enterRun(instance, triangle, m);
     const size_t i0 = b.used, n = end - first;
     b.used += n;
     const int32_t r = int32_t(b.runs - 1);
@@ -734,10 +738,18 @@ class BlockShader {
   // a new entry in the block's run table unless the last one is the same
   // triangle (the same values either way, so a lane does not depend on
   // its neighbours).
-  void enterRun(uint32_t instance, uint32_t triangle, const Material& m) {
+  // With `corners` and `faceNormal` (the caller's, PrimaryHitBlock), the
+  // triangle's values are made from them instead of the run cache.
+  void enterRun(uint32_t instance, uint32_t triangle, const Material& m, const glm::uvec3* corners = nullptr,
+                const glm::dvec3* faceNormal = nullptr) {
     LaneBlock& b = block_;
     const bool newTriangle = instance != run_.instance || triangle != run_.triangle;
-    if (newTriangle) startRun(instance, triangle);
+    if (newTriangle) {
+      if (corners)
+        makeRun(instance, triangle, *corners, *faceNormal);
+      else
+        startRun(instance, triangle);
+    }
     if (!newTriangle && b.runs != 0) return;
     const size_t r = b.runs++;
     b.ngX[r] = run_.ngF.x;
@@ -791,15 +803,22 @@ class BlockShader {
   }
 
   void computeRun(uint32_t instance, uint32_t triangle) {
+    makeRun(instance, triangle, scene_.triangle(instance, triangle),
+            triangleFaceNormal(scene_, instance, triangle));
+  }
+
+  // run_ from the triangle's corner indices and face normal.
+  void makeRun(uint32_t instance, uint32_t triangle, const glm::uvec3& corners,
+               const glm::dvec3& faceNormal) {
     TriangleRun& r = run_;
     r.instance = instance;
     r.triangle = triangle;
     r.inst = &scene_.instances[instance];
-    r.corners = scene_.triangle(instance, triangle);
+    r.corners = corners;
     r.p0 = glm::dvec3(scene_.positions[r.corners.x]);
     r.p1 = glm::dvec3(scene_.positions[r.corners.y]);
     r.p2 = glm::dvec3(scene_.positions[r.corners.z]);
-    r.ng = triangleFaceNormal(scene_, instance, triangle);
+    r.ng = faceNormal;
     r.ngF = glm::vec3(r.ng);
     r.authored = r.inst->normals == NormalSource::Authored;
     r.n0 = r.authored ? scene_.normals[r.corners.x] : glm::vec3(0.0f);

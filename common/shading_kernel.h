@@ -135,6 +135,13 @@ struct PrimaryHitBlock {
   // `count`), so the kernel need not look for where runs change.
   size_t runs = 0;
   const uint32_t* runFirst = nullptr;
+  // Optional, per run: the stored triangle's corner indices
+  // (scene.triangle's) and unit face normal (triangleFaceNormal's bits),
+  // where the caller has them (raster setup: TriangleSetup::corners), so
+  // the kernel need not load the indices and compute the normal; a run
+  // whose corners are kNoId takes the kernel's own.
+  const glm::uvec3* runCorners = nullptr;
+  const glm::dvec3* runFaceNormal = nullptr;
 };
 
 // The kernel for blocks of hits (PrimaryHitBlock), built once per caller

@@ -141,6 +141,10 @@ SurfacePoint makeSurfacePoint(const Scene& scene, const SampleHit& hit) {
   return surfacePointAt(scene, hit.instance, hit.triangle, hit.b1, hit.b2);
 }
 
+glm::dvec3 faceNormalOfCorners(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2) {
+  return faceNormal(p0, p1, p2);
+}
+
 glm::dvec3 triangleFaceNormal(const Scene& scene, uint32_t instance, uint32_t triangle) {
   const glm::uvec3 t = scene.triangle(instance, triangle);
   return memoisedFaceNormal(scene.positions[t.x], scene.positions[t.y], scene.positions[t.z]);

@@ -80,7 +80,7 @@ void forEachBinnedTile(const TileGrid& grid, int64_t unitsPerPixel, const Sample
 // from their prefix sums in chunk order, then each chunk fills its own
 // slots, so the bins are the serial result whatever the thread count. The
 // counting pass notes each setup's fate in 4 bytes (not selected, one tile,
-// several tiles), so the filling pass reads the 272-byte setups again only
+// several tiles), so the filling pass reads the 304-byte setups again only
 // for triangles that span tiles.
 template <typename Select>
 std::vector<std::vector<uint32_t>> binTriangles(const TileGrid& grid, const SampleGrid& samples,

@@ -277,7 +277,8 @@ size_t PrimaryBatch::addRow(const uint32_t* winners, size_t first, size_t n, int
       // Small triangles make runs of one or two samples, each on a setup
       // (and its refinement plane) mostly not in cache: the one a few
       // samples on is fetched now.
-      if (i + kRunPrefetch < n && winners[i + kRunPrefetch] != kNoSetup) prefetchRun(winners[i + kRunPrefetch]);
+      if (i + kRunPrefetch < n && winners[i + kRunPrefetch] != kNoSetup)
+        prefetchRun(winners[i + kRunPrefetch]);
       fillRun(runs++, win, used);
       last = win;
     }
@@ -319,6 +320,7 @@ void PrimaryBatch::prefetchRun(uint32_t winner) const {
   __builtin_prefetch(t + offsetof(TriangleSetup, depth));
   __builtin_prefetch(t + offsetof(TriangleSetup, dOverW));
   __builtin_prefetch(t + offsetof(TriangleSetup, b2OverW) + sizeof(PlaneCoefficients) - 1);
+  __builtin_prefetch(t + sizeof(TriangleSetup) - 1);  // corners and face normal, for the kernel
   if (refinePlanes_) {
     const char* p = reinterpret_cast<const char*>(&refinePlanes_[winner]);
     __builtin_prefetch(p);
@@ -339,6 +341,8 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner, size_t firstLane) {
   runFirst_[r] = uint32_t(firstLane);
   runInstance_[r] = t.instance;
   runTriangle_[r] = t.triangle;
+  runCorners_[r] = t.corners;
+  runFaceNormal_[r] = t.faceNormal;
   if (refinePlanes_) {
     // Computed in setup (raster/setup.h: RefinePlane).
     const RefinePlane& p = refinePlanes_[winner];
@@ -424,6 +428,8 @@ PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footp
   h.run = block_->run32;
   h.runInstance = runInstance_;
   h.runTriangle = runTriangle_;
+  h.runCorners = runCorners_;
+  h.runFaceNormal = runFaceNormal_;
   h.dirX = block_->dirX;
   h.dirY = block_->dirY;
   h.dirZ = block_->dirZ;

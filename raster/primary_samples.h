@@ -169,8 +169,8 @@ class PrimaryBatch {
 
  private:
   void fillRun(size_t r, uint32_t winner, size_t firstLane);  // run r's table entry
-  void prefetchRun(uint32_t winner) const;  // what fillRun will read for it
-  static constexpr size_t kRunPrefetch = 8;  // samples ahead in addRow
+  void prefetchRun(uint32_t winner) const;                    // what fillRun will read for it
+  static constexpr size_t kRunPrefetch = 8;                   // samples ahead in addRow
 
   const PrimaryRayConstants& camera_;
   const Scene& scene_;
@@ -182,7 +182,9 @@ class PrimaryBatch {
   const TriangleSetup* runSetup_[primary_detail::kBlock];
   // Per run and per sample, for the kernel (after run()).
   uint32_t runInstance_[primary_detail::kBlock], runTriangle_[primary_detail::kBlock];
-  uint32_t runFirst_[primary_detail::kBlock + 1];  // each run's first sample, then used_ (hits())
+  glm::uvec3 runCorners_[primary_detail::kBlock];     // the setup's (TriangleSetup::corners)
+  glm::dvec3 runFaceNormal_[primary_detail::kBlock];  // the setup's (TriangleSetup::faceNormal)
+  uint32_t runFirst_[primary_detail::kBlock + 1];     // each run's first sample, then used_ (hits())
   // The stored triangle's plane as a run needs it (with the eye-dependent
   // terms as intersectTrianglePlane's memo computes them), for recent
   // triangles: a function of the triangle and the eye alone, cached by

@@ -12,6 +12,7 @@
 #include "common/error.h"
 #include "common/parallel.h"
 #include "common/sampling.h"
+#include "common/triangle_plane.h"
 #include "raster/depth.h"
 #include "raster/huge_pages.h"
 
@@ -280,7 +281,7 @@ struct SetupContext {
 // positions are p: transform, clip, set up each fan piece, keep those that
 // may cover a sample; a triangle that keeps no piece is counted by why.
 void setupClipped(const SetupContext& c, CullMode instanceCull, uint32_t instance, uint32_t triangle,
-                  const glm::dvec3 p[3], ChunkOutput* out) {
+                  const glm::uvec3& corners, const glm::dvec3 p[3], ChunkOutput* out) {
   SetupCounters& n = out->counters;
   const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
   const ClipResult cr = clipTriangle(c.space, clip);
@@ -298,6 +299,8 @@ void setupClipped(const SetupContext& c, CullMode instanceCull, uint32_t instanc
   t.triangle = triangle;
   t.fromClipping = cr.outcome == ClipOutcome::Clipped;
   t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
+  t.corners = corners;
+  t.faceNormal = faceNormalOfCorners(p[0], p[1], p[2]);
   bool culled = false, visible = false, degenerate = false, sampleless = false;
   for (int i = 1; i + 1 < cr.count; ++i) {
     const ClipVertex fan[3] = {cr.vertices[0], cr.vertices[i], cr.vertices[i + 1]};
@@ -361,11 +364,12 @@ void setupChunkReference(const SetupContext& c, const SetupChunk& chunk, ChunkOu
       continue;
     ++n.trianglesIn;
     glm::dvec3 p[3];
-    if (!loadTriangle(c.scene, c.scene.triangles[inst.firstTriangle + k], p)) {
+    const glm::uvec3 idx = c.scene.triangles[inst.firstTriangle + k];
+    if (!loadTriangle(c.scene, idx, p)) {
       ++n.degenerate;  // SPEC §1: zero world area covers nothing
       continue;
     }
-    setupClipped(c, instanceCull, chunk.instance, k, p, out);
+    setupClipped(c, instanceCull, chunk.instance, k, idx, p, out);
   }
 }
 
@@ -406,7 +410,7 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
     const glm::uvec3 local = idx - glm::uvec3(inst.firstVertex);
     if (local.x >= inst.vertexCount || local.y >= inst.vertexCount || local.z >= inst.vertexCount) {
       if (!anyDegenerate) loadPositions(c.scene, idx, p);
-      setupClipped(c, instanceCull, chunk.instance, k, p, out);
+      setupClipped(c, instanceCull, chunk.instance, k, idx, p, out);
       continue;
     }
     const uint8_t m0 = codes.outside[idx.x], m1 = codes.outside[idx.y], m2 = codes.outside[idx.z];
@@ -416,7 +420,7 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
     }
     if (m0 | m1 | m2) {  // needs clipping
       if (!anyDegenerate) loadPositions(c.scene, idx, p);
-      setupClipped(c, instanceCull, chunk.instance, k, p, out);
+      setupClipped(c, instanceCull, chunk.instance, k, idx, p, out);
       continue;
     }
     t.triangle = k;
@@ -445,6 +449,8 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
     if (!anyDegenerate) loadPositions(c.scene, idx, p);
     const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
     t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
+    t.corners = idx;
+    t.faceNormal = faceNormalOfCorners(p[0], p[1], p[2]);
     const ClipVertex v[3] = {
         {clip[0], glm::dvec3(1, 0, 0)}, {clip[1], glm::dvec3(0, 1, 0)}, {clip[2], glm::dvec3(0, 0, 1)}};
     const glm::dvec2 image[3] = {c.space.imageOf(clip[0]), c.space.imageOf(clip[1]),

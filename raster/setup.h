@@ -93,11 +93,14 @@ struct EdgeFunction {
   int64_t at(int64_t px, int64_t py) const { return int64_t(a) * px + int64_t(b) * py + c; }
 };
 
-// One set-up triangle (or clipped piece): 272 bytes. What is not kept
+// One set-up triangle (or clipped piece): 304 bytes. What is not kept
 // because it can be derived: the clip vertices' barycentrics (only
 // `original` needs them), the parent's stored index (the instance's first
 // triangle + `triangle`), the maximum depth slope (from the depth plane),
-// and the interpolation planes' shared origin.
+// and the interpolation planes' shared origin. The last 36 bytes (the
+// stored triangle's corners and face normal) are read by the shading
+// kernel only, once per run of samples, so the depth pass's lines are
+// the same as without them.
 struct TriangleSetup {
   uint32_t instance = 0, triangle = 0;
   glm::ivec2 vertex[3];                  // snapped, units; |X|, |Y| <= 2^29 fit int32
@@ -109,6 +112,15 @@ struct TriangleSetup {
   double centroidDepth = 0.0;  // view depth of the ORIGINAL triangle's centroid (sorted mode)
   bool frontFacing = true;
   bool fromClipping = false;
+  // The stored (parent) triangle's corner indices, scene.triangle(instance,
+  // triangle), and its unit face normal, triangleFaceNormal's bits
+  // (faceNormalOfCorners in common/triangle_plane.h), as prepareTriangles
+  // computes them while it holds the corners: the shading kernel takes
+  // them per run instead of loading the indices and dividing by a square
+  // root per triangle (PrimaryHitBlock::runCorners). kNoId corners: not
+  // computed (setupTriangle alone leaves them).
+  glm::uvec3 corners{kNoId};
+  glm::dvec3 faceNormal{0.0, 0.0, 1.0};
 
   uint64_t id() const { return (uint64_t(instance) << 32) | triangle; }
   // max(|∂z/∂x|, |∂z/∂y|) before offset (the offset moves only depth.v0).

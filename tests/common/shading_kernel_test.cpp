@@ -432,3 +432,89 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
 
 }  // namespace
 }  // namespace rastray
+
+namespace rastray {
+namespace {
+
+// A caller's per-run corners and face normals (PrimaryHitBlock::runCorners,
+// raster setup's) give the kernel's own bits: runs with and without them
+// mixed in a block, the eye light and lights, every target. And the kernel
+// reads them: a wrong normal given changes the colours.
+TEST(ShadingKernel, RunCornersAndFaceNormalsGivenGiveTheKernelsOwnBits) {
+  Scene lit = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
+  Scene eyeLit = lit;
+  eyeLit.lights.clear();
+  for (const Scene* scene : {&lit, &eyeLit}) {
+    SCOPED_TRACE(scene == &lit ? "lights" : "eye light");
+    const Camera camera = makeCamera(*scene, {}, 64, 48);
+    const std::vector<ShadeHit> hits = primaryHits(*scene, camera, 1500);
+    ASSERT_GT(hits.size(), 500u);
+    const Shader shader(*scene, analyzeScene(*scene), camera, {}, nullptr, nullptr);
+    const size_t n = hits.size();
+    std::vector<glm::vec4> expected(n);
+    shadePrimaryHits(shader, hits.data(), n, expected.data(), ShadingPath::Kernel);
+    std::vector<int32_t> run(n);
+    std::vector<uint32_t> colorIndex(n);
+    std::vector<double> dx(n), dy(n), dz(n), fx(n), fy(n);
+    std::vector<float> b1(n), b2(n);
+    for (size_t i = 0; i < n; ++i) {
+      dx[i] = hits[i].direction.x, dy[i] = hits[i].direction.y, dz[i] = hits[i].direction.z;
+      fx[i] = hits[i].footprintPosition.x, fy[i] = hits[i].footprintPosition.y;
+      b1[i] = hits[i].b1, b2[i] = hits[i].b2;
+      colorIndex[i] = uint32_t(i);
+    }
+    // wrong: every run given a wrong normal (its components rotated: the
+    // liveness check; a reversed one would be faced back towards the eye).
+    const auto shadeGiven = [&](bool wrong) {
+      PrimaryHitShader kernel(shader, ShadingPath::Kernel);
+      std::vector<glm::vec4> got(n, glm::vec4(-1.0f));
+      std::vector<uint32_t> runInstance, runTriangle;
+      std::vector<glm::uvec3> corners;
+      std::vector<glm::dvec3> normals;
+      for (size_t first = 0; first < n; first += kPrimaryHitBlock) {
+        const size_t count = std::min(kPrimaryHitBlock, n - first);
+        runInstance.clear(), runTriangle.clear(), corners.clear(), normals.clear();
+        for (size_t k = 0; k < count; ++k) {
+          const ShadeHit& h = hits[first + k];
+          if (k == 0 || h.instance != runInstance.back() || h.triangle != runTriangle.back()) {
+            runInstance.push_back(h.instance);
+            runTriangle.push_back(h.triangle);
+            // Every third run without: the kernel's own values.
+            const bool given = wrong || runInstance.size() % 3 != 0;
+            corners.push_back(given ? scene->triangle(h.instance, h.triangle) : glm::uvec3(kNoId));
+            const glm::dvec3 ng = triangleFaceNormal(*scene, h.instance, h.triangle);
+            normals.push_back(wrong ? glm::dvec3(ng.y, ng.z, ng.x) : ng);
+          }
+          run[first + k] = int32_t(runInstance.size() - 1);
+        }
+        PrimaryHitBlock block;
+        block.count = count;
+        block.run = &run[first];
+        block.runInstance = runInstance.data();
+        block.runTriangle = runTriangle.data();
+        block.runCorners = corners.data();
+        block.runFaceNormal = normals.data();
+        block.dirX = &dx[first], block.dirY = &dy[first], block.dirZ = &dz[first];
+        block.b1 = &b1[first], block.b2 = &b2[first];
+        block.footprintX = &fx[first], block.footprintY = &fy[first];
+        block.colorIndex = &colorIndex[first];
+        kernel.shade(block, got.data());
+      }
+      return got;
+    };
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      SCOPED_TRACE(hwy::TargetName(target));
+      hwy::SetSupportedTargetsForTest(target);
+      const std::vector<glm::vec4> got = shadeGiven(false);
+      for (size_t i = 0; i < n; ++i) ASSERT_TRUE(sameBits(got[i], expected[i])) << "hit " << i;
+    }
+    hwy::SetSupportedTargetsForTest(0);
+    const std::vector<glm::vec4> wrong = shadeGiven(true);
+    size_t changed = 0;
+    for (size_t i = 0; i < n; ++i) changed += !sameBits(wrong[i], expected[i]);
+    EXPECT_GT(changed, n / 4);
+  }
+}
+
+}  // namespace
+}  // namespace rastray

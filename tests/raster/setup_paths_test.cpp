@@ -10,6 +10,7 @@
 #include <cstring>
 #include <random>
 
+#include "common/surface.h"
 #include "raster/bin.h"
 #include "raster/clip.h"
 #include "raster/coverage.h"
@@ -45,6 +46,8 @@ void expectSameSetup(const TriangleSetup& a, const TriangleSetup& b, size_t i) {
   ASSERT_EQ(a.centroidDepth, b.centroidDepth) << i;
   ASSERT_EQ(a.frontFacing, b.frontFacing) << i;
   ASSERT_EQ(a.fromClipping, b.fromClipping) << i;
+  ASSERT_EQ(a.corners, b.corners) << i;
+  ASSERT_EQ(std::memcmp(&a.faceNormal, &b.faceNormal, sizeof(glm::dvec3)), 0) << i;
 }
 
 void expectSameCounters(const SetupCounters& a, const SetupCounters& b, const std::string& what) {
@@ -308,6 +311,39 @@ TEST(SetupPaths, StoredRefinePlanesAreEachSetupsReferencePlane) {
     }
     EXPECT_GT(clipped, 0u);
   }
+}
+
+// Each setup carries its stored triangle's corner indices and face normal
+// for the shading kernel (PrimaryHitBlock::runCorners): scene.triangle's
+// indices and triangleFaceNormal's bits, clipped pieces included (their
+// parent's), on both setup paths (expectSameSetup compares the paths).
+TEST(SetupPaths, SetupsCarryTheStoredTrianglesCornersAndFaceNormal) {
+  Scene scene = terrainScene(160, 3);
+  // Triangles through the near plane, beside the eye: clipped into pieces;
+  // a far, tilted one at a large scale.
+  test::addMesh(
+      scene,
+      {glm::vec3(0.3f, 0.5f, 1.0f), glm::vec3(0.0f, 0.3f, -2.0f), glm::vec3(0.6f, 0.3f, -2.0f),
+       glm::vec3(0.1f, 0.7f, 0.5f), glm::vec3(0.5f, 0.7f, 0.3f), glm::vec3(0.3f, 0.2f, -1.0f),
+       glm::vec3(-3e3f, 1.5e3f, -9e3f), glm::vec3(3e3f, 1.7e3f, -9.5e3f), glm::vec3(1e2f, -2e3f, -8e3f)},
+      {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}});
+  const Frame f = frameOf(160, 90, 1);
+  for (const SetupPath path : {SetupPath::Fast, SetupPath::Reference}) {
+    SetupCounters n;
+    const std::vector<TriangleSetup> setups = setUp(scene, f, CullMode::None, {}, path, &n);
+    ASSERT_GT(setups.size(), 1000u);
+    size_t clipped = 0;
+    for (size_t i = 0; i < setups.size(); ++i) {
+      const TriangleSetup& t = setups[i];
+      clipped += t.fromClipping;
+      ASSERT_EQ(t.corners, scene.triangle(t.instance, t.triangle)) << i;
+      const glm::dvec3 expected = triangleFaceNormal(scene, t.instance, t.triangle);
+      ASSERT_EQ(std::memcmp(&t.faceNormal, &expected, sizeof(glm::dvec3)), 0) << i;
+    }
+    EXPECT_GT(clipped, 0u);
+  }
+  // setupTriangle alone computes neither: the kernel then takes its own.
+  EXPECT_EQ(TriangleSetup{}.corners.x, kNoId);
 }
 
 TEST(SamplelessSetups, OnlySetupsThatCoverNoSampleAreDropped) {
