@@ -258,7 +258,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
   constexpr int kSmallSamples = 16;
   alignas(16) int64_t smallOffsets[3][kSmallSamples];
   uint64_t smallMasks[kSmallSamples];
-  // The next triangles' setups (272 bytes each, mostly not in cache at
+  // The next triangles' setups (304 bytes each, mostly not in cache at
   // 10^6 triangles) are fetched this many triangles ahead.
   constexpr size_t kPrefetch = 4;
   const size_t binSize = bin.size();
