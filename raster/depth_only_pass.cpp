@@ -1,6 +1,7 @@
 #include "raster/depth_only_pass.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <string>
@@ -289,6 +290,57 @@ struct Avx512Row : Avx2Row {
 #pragma GCC diagnostic pop
 #endif
 
+// The smallest and largest key of `plane` over the 8×8 block at (bx, by)
+// (its column terms `column`), from its four corners; false where the
+// corners cannot prove it (a corner's depth not finite or not above 0).
+// Why the corners suffice: a texel's depth is column[i] + rowTerm(j), and
+// every operation of both terms (planeColumnTerms, planeRowTerm) and of
+// the sum is a rounded IEEE operation on one varying operand, which is
+// monotonic in it; so the depth is monotonic along each row and each
+// column, and lies between its corners' values: finite and above 0 (no
+// NaN, no −0). The clamp, the conversion to float and the key are
+// monotonic too, so the keys' extremes are the corners' keys.
+inline bool blockKeyRange(DepthFormat format, const double (&column)[8], const Plane& plane, int by,
+                          double offsetY, uint32_t* lo, uint32_t* hi) {
+  const double r0 = planeRowTerm(plane, by, offsetY), r7 = planeRowTerm(plane, by + B - 1, offsetY);
+  const double z[4] = {column[0] + r0, column[B - 1] + r0, column[0] + r7, column[B - 1] + r7};
+  uint32_t a = 0xFFFFFFFFu, b = 0;
+  for (double v : z) {
+    if (!(v > 0.0) || !std::isfinite(v)) return false;
+    const uint32_t k = depthKey(format, v);
+    a = std::min(a, k);
+    b = std::max(b, k);
+  }
+  *lo = a;
+  *hi = b;
+  return true;
+}
+
+// Computes block hb's keys into the buffer `keys` (rows of kTileSize) from
+// its state: the clear key, or its plane's keys at the samples (the bits
+// of the kernels' keys: planeRowKeys).
+inline void loadBlock(int32_t* keys, const TileRect& rect, int columns, DepthOnlyTile::Blocks& state,
+                      size_t hb, const std::vector<TriangleSetup>& setups, DepthFormat format,
+                      const glm::dvec2& pos) {
+  const int bx = int(hb % size_t(columns)) * B, by = int(hb / size_t(columns)) * B;
+  const int rows = std::min(B, rect.y1 - rect.y0 - by);
+  int32_t* row = keys + size_t(by) * kTileSize + size_t(bx);
+  const uint32_t owner = state.owner[hb];
+  if (owner == kBlockClear) {
+    for (int j = 0; j < rows; ++j, row += kTileSize) std::fill_n(row, B, kClearBiased);
+  } else {
+    const Plane& plane = setups[owner].depth;
+    double column[8];
+    planeColumnTerms(plane, rect.x0 + bx, pos.x, column);
+    for (int j = 0; j < rows; ++j, row += kTileSize) {
+      uint32_t k[8];
+      planeRowKeys(format, column, planeRowTerm(plane, rect.y0 + by + j, pos.y), k);
+      for (int i = 0; i < B; ++i) row[i] = int32_t(k[i] ^ kBias);
+    }
+  }
+  state.inBuffer |= uint64_t(1) << hb;
+}
+
 // drawFast<Avx2Row> passes AVX vectors between functions compiled without
 // AVX, which GCC warns changes the ABI; it is always inlined into drawAvx2
 // (AVX2), so no such call exists.
@@ -298,7 +350,8 @@ struct Avx512Row : Avx2Row {
 // kTileSize), rows of full blocks through `kernel`. Inlined into each
 // kernel's entry point, so that its ISA covers the whole loop.
 template <typename Row>
-__attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRect& rect,
+__attribute__((always_inline)) inline void drawFast(int32_t* keys, DepthOnlyTile::Blocks& state,
+                                                    const TileRect& rect,
                                                     const std::vector<TriangleSetup>& setups,
                                                     const std::vector<uint32_t>& bin, const SampleGrid& grid,
                                                     DepthFormat format, const AlphaTestFunction& alphaTest,
@@ -339,20 +392,43 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
         if (blockMax[hb] != kClearDepthKey &&
             std::max(triangleKey, minKeyOverBlock(t, format, b, pos, pos)) > blockMax[hb])
           continue;
+        const uint64_t bit = uint64_t(1) << hb;
         if constexpr (Row::kFullBlock) {
           if (c == BlockClass::Accept && b.x == bx && b.y == by && b.w == B && b.h == B && !alphaTest &&
               (format == DepthFormat::FloatReversed || format == DepthFormat::Float)) {
             tested += uint64_t(B * B);
             double column[8];
             planeColumnTerms(t.depth, bx, pos.x, column);
+            if (!(state.inBuffer & bit)) {
+              // Clear or another plane, not in the buffer: t takes the
+              // block as its plane when its largest key is below the
+              // block's smallest (every texel passes and holds t's key).
+              uint32_t low, high;
+              if (blockKeyRange(format, column, t.depth, by, pos.y, &low, &high) &&
+                  high < (state.owner[hb] == kBlockClear ? kClearDepthKey : state.minKey[hb])) {
+                state.owner[hb] = index;
+                state.minKey[hb] = low;
+                blockMax[hb] = high;
+                passed += uint64_t(B * B);
+                continue;
+              }
+              loadBlock(keys, rect, columns, state, hb, setups, format, pos);
+            }
             int32_t* row = keys + size_t(by - rect.y0) * kTileSize + size_t(bx - rect.x0);
             int32_t m;
-            passed +=
+            const uint32_t n =
                 Row::fullBlock(format == DepthFormat::FloatReversed, column, t.depth, by, pos.y, row, &m);
+            passed += n;
             blockMax[hb] = uint32_t(m) ^ kBias;
+            // Every texel written: the block is t's plane (its keys also in the buffer).
+            if (n == uint32_t(B * B))
+              state.owner[hb] = index;
+            else if (n != 0)
+              state.owner[hb] = kBlockKeys;
             continue;
           }
         }
+        if (!(state.inBuffer & bit)) loadBlock(keys, rect, columns, state, hb, setups, format, pos);
         if (c == BlockClass::Accept)
           mask = fullBlockMask(b);
         else
@@ -386,6 +462,7 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
           passes |= uint64_t(pass) << (8 * j);
         }
         passed += uint64_t(bitCount(passes));
+        if (passes != 0) state.owner[hb] = kBlockKeys;
         // The block's exact largest key: the rows not drawn as well.
         for (int j = 0; j < bh; ++j) {
           if ((drawnRows >> j) & 1u) continue;
@@ -405,20 +482,21 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
 #pragma GCC diagnostic pop
 
 #if defined(__SSE2__)
-void drawSse2(int32_t* keys, const TileRect& rect, const std::vector<TriangleSetup>& setups,
-              const std::vector<uint32_t>& bin, const SampleGrid& grid, DepthFormat format,
-              const AlphaTestFunction& alphaTest, DepthPassCounters* counters) {
-  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Sse2Row{});
+void drawSse2(int32_t* keys, DepthOnlyTile::Blocks& state, const TileRect& rect,
+              const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
+              const SampleGrid& grid, DepthFormat format, const AlphaTestFunction& alphaTest,
+              DepthPassCounters* counters) {
+  drawFast(keys, state, rect, setups, bin, grid, format, alphaTest, counters, Sse2Row{});
 }
 #endif
 
 #if defined(RASTRAY_DEPTH_ONLY_AVX2)
-__attribute__((target("avx2"))) void drawAvx2(int32_t* keys, const TileRect& rect,
-                                              const std::vector<TriangleSetup>& setups,
+__attribute__((target("avx2"))) void drawAvx2(int32_t* keys, DepthOnlyTile::Blocks& state,
+                                              const TileRect& rect, const std::vector<TriangleSetup>& setups,
                                               const std::vector<uint32_t>& bin, const SampleGrid& grid,
                                               DepthFormat format, const AlphaTestFunction& alphaTest,
                                               DepthPassCounters* counters) {
-  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Avx2Row{});
+  drawFast(keys, state, rect, setups, bin, grid, format, alphaTest, counters, Avx2Row{});
 }
 
 bool hasAvx2() {
@@ -426,27 +504,17 @@ bool hasAvx2() {
   return yes;
 }
 
-__attribute__((target("avx2,avx512f,avx512vl"))) void drawAvx512(int32_t* keys, const TileRect& rect,
-                                                                 const std::vector<TriangleSetup>& setups,
-                                                                 const std::vector<uint32_t>& bin,
-                                                                 const SampleGrid& grid, DepthFormat format,
-                                                                 const AlphaTestFunction& alphaTest,
-                                                                 DepthPassCounters* counters) {
-  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Avx512Row{});
+__attribute__((target("avx2,avx512f,avx512vl"))) void drawAvx512(
+    int32_t* keys, DepthOnlyTile::Blocks& state, const TileRect& rect,
+    const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin, const SampleGrid& grid,
+    DepthFormat format, const AlphaTestFunction& alphaTest, DepthPassCounters* counters) {
+  drawFast(keys, state, rect, setups, bin, grid, format, alphaTest, counters, Avx512Row{});
 }
 
 bool hasAvx512() {
   static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("avx512f") &&
                           __builtin_cpu_supports("avx512vl");
   return yes;
-}
-
-// The tile buffer's clear and its rows' streaming out, 32 bytes a store
-// (a 2048² cube map clears and writes 100 MB a frame; 16-byte stores were
-// about a tenth of the map pass).
-__attribute__((target("avx2"))) void clearAvx2(int32_t* keys, size_t n) {
-  const __m256i clear = _mm256_set1_epi32(kClearBiased);
-  for (size_t i = 0; i < n; i += 8) _mm256_store_si256(reinterpret_cast<__m256i*>(keys + i), clear);
 }
 
 // Streams src[i] ^ kBias into dst for the leading multiple of 8 of
@@ -521,10 +589,33 @@ DepthMap::DepthMap(int w, int h) : width(w), height(h) {
   keys = std::unique_ptr<uint32_t[], DepthMapRelease>(static_cast<uint32_t*>(p), DepthMapRelease{allocated});
 }
 
-DepthOnlyTile::DepthOnlyTile(const TileRect& rect) : rect_(rect) {
+BlockDepthMap::BlockDepthMap(int w, int h, DepthFormat f, const glm::dvec2& samplePosition)
+    : width(w),
+      height(h),
+      blocksX((w + B - 1) / B),
+      format(f),
+      sample(samplePosition),
+      keys(w, h),
+      owner(size_t(blocksX) * size_t((h + B - 1) / B), kBlockClear) {}
+
+void BlockDepthMap::keepPlanes(const std::vector<TriangleSetup>& setups) {
+  std::vector<uint32_t> renumbered(setups.size(), kBlockClear);
+  planes.clear();
+  for (uint32_t& o : owner) {
+    if (o == kBlockClear || o == kBlockKeys) continue;
+    if (renumbered[o] == kBlockClear) {
+      renumbered[o] = uint32_t(planes.size());
+      planes.push_back(setups[o].depth);
+    }
+    o = renumbered[o];
+  }
+}
+
+DepthOnlyTile::DepthOnlyTile(const TileRect& rect) : rect_(rect), columns_((rect.x1 - rect.x0 + B - 1) / B) {
   RASTRAY_CHECK(rect.x1 - rect.x0 <= kTileSize && rect.y1 - rect.y0 <= kTileSize && rect.x0 <= rect.x1 &&
                     rect.y0 <= rect.y1,
                 "a depth-only tile is at most " + std::to_string(kTileSize) + " texels square");
+  std::fill_n(blocks_.owner, kTileBlocks, kBlockClear);
 }
 
 void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
@@ -533,25 +624,20 @@ void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::
   RASTRAY_CHECK(grid.spp == 1,
                 "the depth-only pass takes 1 sample per texel, not " + std::to_string(grid.spp));
   const TileRect& rect = rect_;
-  const int height = rect.y1 - rect.y0;
-  // Clear the rows in use, whole (GCC 12 does not vectorise loops at -O2:
-  // a scalar fill here cost as much as a sixth of the drawing).
-#if defined(RASTRAY_DEPTH_ONLY_AVX2)
-  if (hasAvx2()) {
-    clearAvx2(keys_, size_t(height) * kTileSize);  // rows of kTileSize: a multiple of 8
-  } else {
-    const __m128i clear = _mm_set1_epi32(kClearBiased);
-    for (size_t i = 0; i < size_t(height) * kTileSize; i += 4)
-      _mm_store_si128(reinterpret_cast<__m128i*>(&keys_[i]), clear);
-  }
-#elif defined(__SSE2__)
-  const __m128i clear = _mm_set1_epi32(kClearBiased);
-  for (size_t i = 0; i < size_t(height) * kTileSize; i += 4)
-    _mm_store_si128(reinterpret_cast<__m128i*>(&keys_[i]), clear);
-#else
-  std::fill_n(keys_, size_t(height) * kTileSize, kClearBiased);
-#endif
+  setups_ = &setups;
+  format_ = format;
+  sample_ = grid.positions[0];
+  // Every block starts clear, its keys not in the buffer: the buffer is
+  // cleared block by block when a triangle first draws part of a block.
+  std::fill_n(blocks_.owner, kTileBlocks, kBlockClear);
+  blocks_.inBuffer = 0;
   if (path == CoveragePath::Reference) {
+    // The whole buffer cleared, every block held as keys.
+    const int height = rect.y1 - rect.y0;
+    std::fill_n(keys_, size_t(height) * kTileSize, kClearBiased);
+    const int blocks = columns_ * ((height + B - 1) / B);
+    std::fill_n(blocks_.owner, blocks, kBlockKeys);
+    blocks_.inBuffer = blocks == 64 ? ~uint64_t(0) : (uint64_t(1) << blocks) - 1;
     CoverageScratch scratch;
     for (uint32_t index : bin) {
       const TriangleSetup& t = setups[index];
@@ -573,26 +659,49 @@ void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::
   }
 #if defined(RASTRAY_DEPTH_ONLY_AVX2)
   if (simd == SimdLevel::Best && hasAvx512()) {
-    drawAvx512(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+    drawAvx512(keys_, blocks_, rect, setups, bin, grid, format, alphaTest, counters);
     return;
   }
   if (simd != SimdLevel::Baseline && hasAvx2()) {
-    drawAvx2(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+    drawAvx2(keys_, blocks_, rect, setups, bin, grid, format, alphaTest, counters);
     return;
   }
 #endif
   (void)simd;
 #if defined(__SSE2__)
-  drawSse2(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+  drawSse2(keys_, blocks_, rect, setups, bin, grid, format, alphaTest, counters);
 #else
-  drawFast(keys_, rect, setups, bin, grid, format, alphaTest, counters, ScalarRow{});
+  drawFast(keys_, blocks_, rect, setups, bin, grid, format, alphaTest, counters, ScalarRow{});
 #endif
 }
 
+void DepthOnlyTile::loadAll() {
+  const int blocks = columns_ * ((rect_.y1 - rect_.y0 + B - 1) / B);
+  for (int hb = 0; hb < blocks; ++hb)
+    if (!((blocks_.inBuffer >> hb) & 1u))
+      loadBlock(keys_, rect_, columns_, blocks_, size_t(hb), *setups_, format_, sample_);
+}
+
+int DepthOnlyTile::planeBlocks() const {
+  const int blocks = columns_ * ((rect_.y1 - rect_.y0 + B - 1) / B);
+  int n = 0;
+  for (int hb = 0; hb < blocks; ++hb)
+    n += blocks_.owner[hb] != kBlockClear && blocks_.owner[hb] != kBlockKeys;
+  return n;
+}
+
 void DepthOnlyTile::store(DepthMap* map) const {
+  // Every block's keys: a copy of the tile with the missing blocks loaded.
+  DepthOnlyTile full = *this;
+  if (setups_)
+    full.loadAll();
+  else {
+    const int height = rect_.y1 - rect_.y0;
+    std::fill_n(full.keys_, size_t(height) * kTileSize, kClearBiased);
+  }
   const int width = rect_.x1 - rect_.x0;
   for (int y = rect_.y0; y < rect_.y1; ++y) {
-    const int32_t* src = &keys_[size_t(y - rect_.y0) * kTileSize];
+    const int32_t* src = &full.keys_[size_t(y - rect_.y0) * kTileSize];
     uint32_t* dst = &map->keys[map->index(rect_.x0, y)];
     int i = 0;
 #if defined(__SSE2__)
@@ -613,6 +722,27 @@ void DepthOnlyTile::store(DepthMap* map) const {
 #if defined(__SSE2__)
   _mm_sfence();  // streaming stores are weakly ordered: publish them before the task completes
 #endif
+}
+
+void DepthOnlyTile::store(BlockDepthMap* map) const {
+  const int width = rect_.x1 - rect_.x0, height = rect_.y1 - rect_.y0;
+  const int rowsOfBlocks = (height + B - 1) / B;
+  const size_t first = size_t(rect_.y0 / B) * size_t(map->blocksX) + size_t(rect_.x0 / B);
+  for (int j = 0; j < rowsOfBlocks; ++j)
+    for (int i = 0; i < columns_; ++i) {
+      const size_t hb = size_t(j) * size_t(columns_) + size_t(i);
+      const uint32_t owner = blocks_.owner[hb];
+      map->owner[first + size_t(j) * size_t(map->blocksX) + size_t(i)] = owner;
+      if (owner != kBlockKeys) continue;
+      // Rows of at most 8 keys into memory no cache holds: a block of keys
+      // is the exception (a triangle's edge), so plain stores.
+      const int bw = std::min(B, width - i * B), bh = std::min(B, height - j * B);
+      for (int y = 0; y < bh; ++y) {
+        const int32_t* src = &keys_[size_t(j * B + y) * kTileSize + size_t(i * B)];
+        uint32_t* dst = &map->keys.keys[map->keys.index(rect_.x0 + i * B, rect_.y0 + j * B + y)];
+        for (int x = 0; x < bw; ++x) dst[x] = uint32_t(src[x]) ^ kBias;
+      }
+    }
 }
 
 void rasterDepthOnlyPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,

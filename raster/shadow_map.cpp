@@ -279,7 +279,13 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
     for (size_t f = 0; f < cameras.size(); ++f) {
       const Camera& c = cameras[f];
       const SampleGrid grid = makeSampleGrid(1, size, size);
-      Map map{c, makeClipSpace(c, grid.guardPixels), {}, DepthMap(size, size), TileGrid(size, size), {}, {}};
+      Map map{c,
+              makeClipSpace(c, grid.guardPixels),
+              {},
+              BlockDepthMap(size, size, kMapFormat, grid.positions[0]),
+              TileGrid(size, size),
+              {},
+              {}};
       map.lookup = lookupOf(map.camera, map.space);
       if (cube && faces.empty()) faces = cubeFaceCandidates(scene, light.position, map.space.scale.x, size);
       DepthSettings ds{
@@ -323,6 +329,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         const TileRect rect = tiles.rect(tile);
         DepthOnlyTile depth(rect);
         depth.render(setups, bins[size_t(tile)], grid, kMapFormat, alphaTest, &dc, path);
+        if (!transmissiveBins[size_t(tile)].empty()) depth.loadAll();  // key() below reads the buffer
         // Attenuating fragments in front of the opaque depth, kept per texel.
         std::vector<Attenuation>& found = perTile[size_t(tile)];
         CoverageScratch scratch;
@@ -336,7 +343,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
           any.material = &m;
           const glm::vec3 uniform = constant ? shader->shadowTransmittance(any) : glm::vec3(1.0f);
           forEachCoveredSample(t, grid, rect, scratch, [&](int px, int py, int s) {
-            const size_t texel = map.depth.index(px, py);
+            const size_t texel = map.depth.keys.index(px, py);
             const uint32_t key = sampleDepthKey(t, grid, kMapFormat, px, py, s);
             if (key >= depth.key(px, py)) return;
             const glm::vec3 pass = constant ? uniform : shader->shadowTransmittance(surfaceAt(t, px, py, s));
@@ -348,6 +355,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         sortTileFragments(rect, size_t(map.depth.width), &found);
       });
       throwIfStopped(options.cancel);
+      map.depth.keepPlanes(setups);
       indexAttenuation(perTile, &map);
       attenuating_ += map.attenuation.size();
       perLight_[l].push_back(std::move(map));
@@ -370,8 +378,8 @@ glm::vec3 ShadowMaps::litReference(const Map& map, const glm::dvec3& world, cons
   const double d = receiverDepth(map.lookup, view, v.position.z, viewNormal(map.lookup, normal), x, y);
   const double z = windowDepth(kMapFormat, map.camera.projection, map.camera.znear, map.camera.zfar, d);
   const uint32_t key = depthKey(kMapFormat, z);
-  const uint32_t texel = uint32_t(map.depth.index(x, y));
-  if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
+  const uint32_t texel = uint32_t(map.depth.keys.index(x, y));
+  if (key > map.depth.key(x, y)) return glm::vec3(0.0f);
   // Attenuation by the transmissive layers between the light and the point.
   const size_t tile = size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize);
   const auto first = map.attenuation.begin() + map.attenuationRows[tile * kTileSize];
@@ -410,8 +418,8 @@ glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world, const glm::dv
   else
     z = k.znear * (k.zfar - dc) / (dc * (k.zfar - k.znear));
   const uint32_t key = depthKey(kMapFormat, z);
-  const uint32_t texel = uint32_t(map.depth.index(x, y));
-  if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
+  const uint32_t texel = uint32_t(map.depth.keys.index(x, y));
+  if (key > map.depth.key(x, y)) return glm::vec3(0.0f);
   // Attenuation by the transmissive layers between the light and the point:
   // only the fragments of the texel's row within its tile are searched.
   const size_t slot = (size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize)) * kTileSize +

@@ -124,7 +124,7 @@ class ShadowMaps : public LightVisibility {
     Camera camera;
     ClipSpace space;
     Lookup lookup;
-    DepthMap depth;
+    BlockDepthMap depth;  // by 8×8 blocks: clear, a plane or keys
     TileGrid tiles{0, 0};
     // The transmissive fragments in front of the opaque depth: by tile,
     // then (texel, key); equal keys at a texel in the order the pass met
