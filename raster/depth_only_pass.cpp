@@ -217,6 +217,46 @@ struct Avx2Row {
     return pass;
   }
 
+  // The smallest and largest key of `plane` over the 8×8 block at (bx, by)
+  // (samples at offsetX, offsetY within the texels), float formats, from
+  // its four corners; false where the corners cannot prove it (a corner's
+  // depth not finite or not above 0). Why the corners suffice: a texel's
+  // depth is column[i] + rowTerm(j), and every operation of both terms
+  // (planeColumnTerms, planeRowTerm, computed here lane by lane with the
+  // same operations) and of the sum is a rounded IEEE operation with one
+  // varying operand, monotonic in it; so the depth is monotonic along
+  // each row and each column and lies between its corners' values: finite
+  // and above 0 (no NaN, no −0). The clamp, the conversion to float and
+  // the key are monotonic too, so the keys' extremes are the corners'.
+  __attribute__((target("avx2"))) static bool keyRange(bool reversed, const Plane& p, int bx, double offsetX,
+                                                       int by, double offsetY, uint32_t* lo, uint32_t* hi) {
+    // Lanes: columns bx and bx + 7, rows by and by + 7.
+    const __m256d at = _mm256_setr_pd(double(bx), double(bx + B - 1), double(by), double(by + B - 1));
+    const __m256d offset = _mm256_setr_pd(offsetX, offsetX, offsetY, offsetY);
+    const __m256d origin = _mm256_setr_pd(p.x0, p.x0, p.y0, p.y0);
+    const __m256d slope = _mm256_setr_pd(p.dx, p.dx, p.dy, p.dy);
+    const __m256d terms = _mm256_mul_pd(slope, _mm256_sub_pd(_mm256_add_pd(at, offset), origin));
+    const __m128d column = _mm_add_pd(_mm_set1_pd(p.v0), _mm256_castpd256_pd128(terms));  // c0, c7
+    const __m128d row = _mm256_extractf128_pd(terms, 1);                                  // r0, r7
+    // (c0 + r0, c7 + r0, c0 + r7, c7 + r7)
+    const __m256d z = _mm256_add_pd(_mm256_set_m128d(column, column),
+                                    _mm256_set_m128d(_mm_unpackhi_pd(row, row), _mm_unpacklo_pd(row, row)));
+    const __m256d absZ = _mm256_andnot_pd(_mm256_set1_pd(-0.0), z);
+    const __m256d ok = _mm256_and_pd(_mm256_cmp_pd(z, _mm256_setzero_pd(), _CMP_GT_OQ),
+                                     _mm256_cmp_pd(absZ, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OQ));
+    if (_mm256_movemask_pd(ok) != 0xF) return false;
+    // depthKey: clamp (z > 0: the upper bound only), float, key.
+    const __m128i bits = _mm_castps_si128(_mm256_cvtpd_ps(_mm256_min_pd(_mm256_set1_pd(1.0), z)));
+    const __m128i keys = reversed ? _mm_sub_epi32(_mm_set1_epi32(0x3F800000), bits) : bits;
+    __m128i mn = _mm_min_epu32(keys, _mm_shuffle_epi32(keys, _MM_SHUFFLE(1, 0, 3, 2)));
+    __m128i mx = _mm_max_epu32(keys, _mm_shuffle_epi32(keys, _MM_SHUFFLE(1, 0, 3, 2)));
+    mn = _mm_min_epu32(mn, _mm_shuffle_epi32(mn, _MM_SHUFFLE(2, 3, 0, 1)));
+    mx = _mm_max_epu32(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(2, 3, 0, 1)));
+    *lo = uint32_t(_mm_cvtsi128_si32(mn));
+    *hi = uint32_t(_mm_cvtsi128_si32(mx));
+    return true;
+  }
+
   // A whole 8×8 block the triangle covers, float formats, no alpha test:
   // each row's keys, test and write as operator() computes them (the same
   // column terms, planeRowTerm, clamp, conversion and compare, so the same
@@ -290,38 +330,13 @@ struct Avx512Row : Avx2Row {
 #pragma GCC diagnostic pop
 #endif
 
-// The smallest and largest key of `plane` over the 8×8 block at (bx, by)
-// (its column terms `column`), from its four corners; false where the
-// corners cannot prove it (a corner's depth not finite or not above 0).
-// Why the corners suffice: a texel's depth is column[i] + rowTerm(j), and
-// every operation of both terms (planeColumnTerms, planeRowTerm) and of
-// the sum is a rounded IEEE operation on one varying operand, which is
-// monotonic in it; so the depth is monotonic along each row and each
-// column, and lies between its corners' values: finite and above 0 (no
-// NaN, no −0). The clamp, the conversion to float and the key are
-// monotonic too, so the keys' extremes are the corners' keys.
-inline bool blockKeyRange(DepthFormat format, const double (&column)[8], const Plane& plane, int by,
-                          double offsetY, uint32_t* lo, uint32_t* hi) {
-  const double r0 = planeRowTerm(plane, by, offsetY), r7 = planeRowTerm(plane, by + B - 1, offsetY);
-  const double z[4] = {column[0] + r0, column[B - 1] + r0, column[0] + r7, column[B - 1] + r7};
-  uint32_t a = 0xFFFFFFFFu, b = 0;
-  for (double v : z) {
-    if (!(v > 0.0) || !std::isfinite(v)) return false;
-    const uint32_t k = depthKey(format, v);
-    a = std::min(a, k);
-    b = std::max(b, k);
-  }
-  *lo = a;
-  *hi = b;
-  return true;
-}
-
 // Computes block hb's keys into the buffer `keys` (rows of kTileSize) from
 // its state: the clear key, or its plane's keys at the samples (the bits
 // of the kernels' keys: planeRowKeys).
-inline void loadBlock(int32_t* keys, const TileRect& rect, int columns, DepthOnlyTile::Blocks& state,
-                      size_t hb, const std::vector<TriangleSetup>& setups, DepthFormat format,
-                      const glm::dvec2& pos) {
+__attribute__((always_inline)) inline void loadBlock(int32_t* keys, const TileRect& rect, int columns,
+                                                     DepthOnlyTile::Blocks& state, size_t hb,
+                                                     const std::vector<TriangleSetup>& setups,
+                                                     DepthFormat format, const glm::dvec2& pos) {
   const int bx = int(hb % size_t(columns)) * B, by = int(hb / size_t(columns)) * B;
   const int rows = std::min(B, rect.y1 - rect.y0 - by);
   int32_t* row = keys + size_t(by) * kTileSize + size_t(bx);
@@ -397,14 +412,13 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, DepthOnlyTile
           if (c == BlockClass::Accept && b.x == bx && b.y == by && b.w == B && b.h == B && !alphaTest &&
               (format == DepthFormat::FloatReversed || format == DepthFormat::Float)) {
             tested += uint64_t(B * B);
-            double column[8];
-            planeColumnTerms(t.depth, bx, pos.x, column);
             if (!(state.inBuffer & bit)) {
               // Clear or another plane, not in the buffer: t takes the
               // block as its plane when its largest key is below the
               // block's smallest (every texel passes and holds t's key).
               uint32_t low, high;
-              if (blockKeyRange(format, column, t.depth, by, pos.y, &low, &high) &&
+              if (Row::keyRange(format == DepthFormat::FloatReversed, t.depth, bx, pos.x, by, pos.y, &low,
+                                &high) &&
                   high < (state.owner[hb] == kBlockClear ? kClearDepthKey : state.minKey[hb])) {
                 state.owner[hb] = index;
                 state.minKey[hb] = low;
@@ -414,6 +428,8 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, DepthOnlyTile
               }
               loadBlock(keys, rect, columns, state, hb, setups, format, pos);
             }
+            double column[8];
+            planeColumnTerms(t.depth, bx, pos.x, column);
             int32_t* row = keys + size_t(by - rect.y0) * kTileSize + size_t(bx - rect.x0);
             int32_t m;
             const uint32_t n =
