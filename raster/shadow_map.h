@@ -126,12 +126,13 @@ class ShadowMaps : public LightVisibility {
     Lookup lookup;
     BlockDepthMap depth;  // by 8×8 blocks: clear, a plane or keys
     TileGrid tiles{0, 0};
-    // The transmissive fragments in front of the opaque depth: by tile,
-    // then (texel, key); equal keys at a texel in the order the pass met
+    // The transmissive fragments in front of the opaque depth, per tile
+    // (each tile's own vector, as its task sorted it: no copy into one),
+    // by (texel, key); equal keys at a texel in the order the pass met
     // them (bin order, then texel order).
-    std::vector<Attenuation> attenuation;
-    // Per tile and row within it (tile · kTileSize + row): the first
-    // fragment of that row of the tile; one more entry ends the last tile.
+    std::vector<std::vector<Attenuation>> attenuation;
+    // Per tile, kTileSize + 1 entries (tile · (kTileSize + 1) + row): the
+    // first fragment of each row of the tile in its vector, then its size.
     std::vector<uint32_t> attenuationRows;
   };
 
