@@ -228,10 +228,12 @@ struct Avx2Row {
   // each row and each column and lies between its corners' values: finite
   // and above 0 (no NaN, no −0). The clamp, the conversion to float and
   // the key are monotonic too, so the keys' extremes are the corners'.
+  // The same over the n × n texels at (bx, by) (a block, n = 8, or a tile).
   __attribute__((target("avx2"))) static bool keyRange(bool reversed, const Plane& p, int bx, double offsetX,
-                                                       int by, double offsetY, uint32_t* lo, uint32_t* hi) {
-    // Lanes: columns bx and bx + 7, rows by and by + 7.
-    const __m256d at = _mm256_setr_pd(double(bx), double(bx + B - 1), double(by), double(by + B - 1));
+                                                       int by, double offsetY, uint32_t* lo, uint32_t* hi,
+                                                       int n = B) {
+    // Lanes: columns bx and bx + n − 1, rows by and by + n − 1.
+    const __m256d at = _mm256_setr_pd(double(bx), double(bx + n - 1), double(by), double(by + n - 1));
     const __m256d offset = _mm256_setr_pd(offsetX, offsetX, offsetY, offsetY);
     const __m256d origin = _mm256_setr_pd(p.x0, p.x0, p.y0, p.y0);
     const __m256d slope = _mm256_setr_pd(p.dx, p.dx, p.dy, p.dy);
@@ -386,12 +388,40 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, DepthOnlyTile
   uint64_t mask = 0;
   uint64_t tested = 0, passed = 0;
 
+  // Blocks taken as a plane with a whole tile, whose key range (blockMax,
+  // minKey) is computed when a later triangle first meets the block.
+  uint64_t rangeUnknown = 0;
+  const bool wholeTiles = Row::kFullBlock && !alphaTest && rect.x1 - rect.x0 == kTileSize &&
+                          rect.y1 - rect.y0 == kTileSize &&
+                          (format == DepthFormat::FloatReversed || format == DepthFormat::Float);
+
   for (uint32_t index : bin) {
     const TriangleSetup& t = setups[index];
     const PixelBounds r = boundsIn(t, rect);
     if (r.empty()) continue;
     counters->coverageTests += r.samples(1);
     prepareOffsets(t, grid, scratch);
+    if constexpr (Row::kFullBlock) {
+      // The first triangle drawn covering the whole tile, nearer than the
+      // clear key everywhere: every block becomes its plane at once (what
+      // the blocks' claims below would do one by one, counters included).
+      if (wholeTiles && state.inBuffer == 0 && rangeUnknown == 0 &&
+          std::all_of(state.owner, state.owner + kTileBlocks, [](uint32_t o) { return o == kBlockClear; })) {
+        int64_t lo[3];
+        uint32_t low, high;
+        if (classifyBlock(t, scratch, U, PixelBlock{rect.x0, rect.y0, kTileSize, kTileSize}, lo) ==
+                BlockClass::Accept &&
+            Row::keyRange(format == DepthFormat::FloatReversed, t.depth, rect.x0, pos.x, rect.y0, pos.y, &low,
+                          &high, kTileSize) &&
+            high < kClearDepthKey) {
+          std::fill_n(state.owner, kTileBlocks, index);
+          rangeUnknown = ~uint64_t(0);
+          tested += uint64_t(kTileSize) * kTileSize;
+          passed += uint64_t(kTileSize) * kTileSize;
+          continue;
+        }
+      }
+    }
     const uint32_t triangleKey = minKeyOverTriangle(t, format, U);
     const RowContext ctx{format, alphaTest, t, counters};
     for (int by = rect.y0 + (r.y0 - rect.y0) / B * B; by <= r.y1; by += B)
@@ -403,6 +433,19 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, DepthOnlyTile
         const BlockClass c = classifyBlock(t, scratch, U, b, lo);
         if (c == BlockClass::Reject) continue;
         const size_t hb = size_t((by - rect.y0) / B) * size_t(columns) + size_t((bx - rect.x0) / B);
+        if constexpr (Row::kFullBlock) {
+          if ((rangeUnknown >> hb) & 1u) {
+            // The tile's range proved the block's corners finite and above 0.
+            uint32_t low = 0, high = 0;
+            const bool known =
+                Row::keyRange(format == DepthFormat::FloatReversed, setups[state.owner[hb]].depth, bx, pos.x,
+                              by, pos.y, &low, &high);
+            RASTRAY_CHECK(known, "a block of a tile's plane has its key range");
+            state.minKey[hb] = low;
+            blockMax[hb] = high;
+            rangeUnknown &= ~(uint64_t(1) << hb);
+          }
+        }
         // Hierarchical test: behind every stored key of the block.
         if (blockMax[hb] != kClearDepthKey &&
             std::max(triangleKey, minKeyOverBlock(t, format, b, pos, pos)) > blockMax[hb])
