@@ -654,14 +654,14 @@ BlockDepthMap::BlockDepthMap(int w, int h, DepthFormat f, const glm::dvec2& samp
       blocksX((w + B - 1) / B),
       format(f),
       sample(samplePosition),
-      keys(w, h),
+      keys(blocksX * B, (h + B - 1) / B * B),
       owner(size_t(blocksX) * size_t((h + B - 1) / B), kBlockClear) {}
 
 void BlockDepthMap::keepPlanes(const std::vector<TriangleSetup>& setups) {
   std::vector<uint32_t> renumbered(setups.size(), kBlockClear);
   planes.clear();
   for (uint32_t& o : owner) {
-    if (o == kBlockClear || o == kBlockKeys) continue;
+    if (!isPlane(o)) continue;
     if (renumbered[o] == kBlockClear) {
       renumbered[o] = uint32_t(planes.size());
       planes.push_back(setups[o].depth);
@@ -784,24 +784,43 @@ void DepthOnlyTile::store(DepthMap* map) const {
 }
 
 void DepthOnlyTile::store(BlockDepthMap* map) const {
-  const int width = rect_.x1 - rect_.x0, height = rect_.y1 - rect_.y0;
+  const int height = rect_.y1 - rect_.y0;
   const int rowsOfBlocks = (height + B - 1) / B;
+  const int blocks = columns_ * rowsOfBlocks;
+  int withKeys = 0;
+  for (int hb = 0; hb < blocks; ++hb) withKeys += blocks_.owner[hb] == kBlockKeys;
+  uint32_t slot = withKeys ? __atomic_fetch_add(&map->slotsUsed, uint32_t(withKeys), __ATOMIC_RELAXED) : 0;
   const size_t first = size_t(rect_.y0 / B) * size_t(map->blocksX) + size_t(rect_.x0 / B);
   for (int j = 0; j < rowsOfBlocks; ++j)
     for (int i = 0; i < columns_; ++i) {
       const size_t hb = size_t(j) * size_t(columns_) + size_t(i);
-      const uint32_t owner = blocks_.owner[hb];
-      map->owner[first + size_t(j) * size_t(map->blocksX) + size_t(i)] = owner;
+      uint32_t& owner = map->owner[first + size_t(j) * size_t(map->blocksX) + size_t(i)];
+      owner = blocks_.owner[hb];
       if (owner != kBlockKeys) continue;
-      // Rows of at most 8 keys into memory no cache holds: a block of keys
-      // is the exception (a triangle's edge), so plain stores.
-      const int bw = std::min(B, width - i * B), bh = std::min(B, height - j * B);
-      for (int y = 0; y < bh; ++y) {
-        const int32_t* src = &keys_[size_t(j * B + y) * kTileSize + size_t(i * B)];
-        uint32_t* dst = &map->keys.keys[map->keys.index(rect_.x0 + i * B, rect_.y0 + j * B + y)];
-        for (int x = 0; x < bw; ++x) dst[x] = uint32_t(src[x]) ^ kBias;
+      owner = kBlockSlot | slot;
+      // The block's 64 keys in 256 contiguous bytes: whole cache lines,
+      // streamed where the build allows (lanes and rows beyond the rect are
+      // never read).
+      uint32_t* dst = &map->keys.keys[size_t(slot) * 64];
+      const int32_t* src = &keys_[size_t(j * B) * kTileSize + size_t(i * B)];
+      const int bh = std::min(B, height - j * B);
+      for (int y = 0; y < B; ++y, dst += B) {
+        const int32_t* row = src + size_t(std::min(y, bh - 1)) * kTileSize;  // rows below the rect: any
+#if defined(__SSE2__)
+        const __m128i bias = _mm_set1_epi32(int32_t(kBias));
+        _mm_stream_si128(reinterpret_cast<__m128i*>(dst),
+                         _mm_xor_si128(_mm_load_si128(reinterpret_cast<const __m128i*>(row)), bias));
+        _mm_stream_si128(reinterpret_cast<__m128i*>(dst + 4),
+                         _mm_xor_si128(_mm_load_si128(reinterpret_cast<const __m128i*>(row + 4)), bias));
+#else
+        for (int x = 0; x < B; ++x) dst[x] = uint32_t(row[x]) ^ kBias;
+#endif
       }
+      ++slot;
     }
+#if defined(__SSE2__)
+  _mm_sfence();  // streaming stores are weakly ordered: publish them before the task completes
+#endif
 }
 
 void rasterDepthOnlyPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,

@@ -96,25 +96,32 @@ constexpr int kTileBlocks = (kTileSize / 8) * (kTileSize / 8);
 
 // A one-sample depth map stored by 8×8 blocks, as the depth-only pass
 // leaves it: per block, clear, a plane (an index into `planes`) or keys
-// (in `keys`, row-major like a DepthMap; the texels of other blocks are
-// indeterminate there). key(x, y) is the key a DepthMap of the same pass
+// (kBlockSlot | slot: the block's 64 keys at slot · 64 of `keys`, rows of
+// 8, the tiles' blocks of keys packed from the start of the buffer in the
+// order the tiles stored them, so a map touches only the memory its
+// blocks of keys fill). key(x, y) is the key a DepthMap of the same pass
 // holds at (x, y), bit for bit.
+constexpr uint32_t kBlockSlot = 0x80000000u;
 struct BlockDepthMap {
   int width = 0, height = 0, blocksX = 0;
   DepthFormat format = DepthFormat::FloatReversed;
-  glm::dvec2 sample{0.5};  // the texels' sample position within them
-  DepthMap keys;
-  std::vector<uint32_t> owner;  // per block, rows of blocksX: kBlockClear, kBlockKeys or a plane
+  glm::dvec2 sample{0.5};       // the texels' sample position within them
+  DepthMap keys;                // blocks of keys, 64 a slot (as many slots as blocks)
+  uint32_t slotsUsed = 0;       // taken atomically by the tiles' stores
+  std::vector<uint32_t> owner;  // per block, rows of blocksX: kBlockClear, a plane or kBlockSlot | slot
   std::vector<Plane> planes;
   BlockDepthMap() = default;
   BlockDepthMap(int w, int h, DepthFormat f, const glm::dvec2& samplePosition);
+  static bool isPlane(uint32_t o) { return o < kBlockSlot; }
+  // Texel (x, y)'s index in the map's row-major order (y · width + x).
+  size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
   uint32_t key(int x, int y) const {
     const uint32_t o = owner[size_t(y / 8) * size_t(blocksX) + size_t(x / 8)];
-    if (o == kBlockKeys) return keys.key(x, y);
     if (o == kBlockClear) return kClearDepthKey;
+    if (o & kBlockSlot) return keys.keys[size_t(o & ~kBlockSlot) * 64 + size_t(y % 8) * 8 + size_t(x % 8)];
     return depthKey(format, planes[o].at(double(x) + sample.x, double(y) + sample.y));
   }
-  // After every tile is stored (their owners are setup indices): keeps
+  // After every tile is stored (their planes are setup indices): keeps
   // only the planes of the setups that own blocks, renumbered.
   void keepPlanes(const std::vector<TriangleSetup>& setups);
 };

@@ -327,7 +327,7 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
           any.material = &m;
           const glm::vec3 uniform = constant ? shader->shadowTransmittance(any) : glm::vec3(1.0f);
           forEachCoveredSample(t, grid, rect, scratch, [&](int px, int py, int s) {
-            const size_t texel = map.depth.keys.index(px, py);
+            const size_t texel = map.depth.index(px, py);
             const uint32_t key = sampleDepthKey(t, grid, kMapFormat, px, py, s);
             if (key >= depth.key(px, py)) return;
             const glm::vec3 pass = constant ? uniform : shader->shadowTransmittance(surfaceAt(t, px, py, s));
@@ -363,7 +363,7 @@ glm::vec3 ShadowMaps::litReference(const Map& map, const glm::dvec3& world, cons
   const double d = receiverDepth(map.lookup, view, v.position.z, viewNormal(map.lookup, normal), x, y);
   const double z = windowDepth(kMapFormat, map.camera.projection, map.camera.znear, map.camera.zfar, d);
   const uint32_t key = depthKey(kMapFormat, z);
-  const uint32_t texel = uint32_t(map.depth.keys.index(x, y));
+  const uint32_t texel = uint32_t(map.depth.index(x, y));
   if (key > map.depth.key(x, y)) return glm::vec3(0.0f);
   // Attenuation by the transmissive layers between the light and the point.
   const size_t tile = size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize);
@@ -403,7 +403,7 @@ glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world, const glm::dv
   else
     z = k.znear * (k.zfar - dc) / (dc * (k.zfar - k.znear));
   const uint32_t key = depthKey(kMapFormat, z);
-  const uint32_t texel = uint32_t(map.depth.keys.index(x, y));
+  const uint32_t texel = uint32_t(map.depth.index(x, y));
   if (key > map.depth.key(x, y)) return glm::vec3(0.0f);
   // Attenuation by the transmissive layers between the light and the point:
   // only the fragments of the texel's row within its tile are searched.

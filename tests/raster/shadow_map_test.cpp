@@ -128,7 +128,7 @@ TEST(ShadowMapPass, BlockMapsLookUpAsTheReferenceMapsOnTheBundledLitScenes) {
     for (size_t i = 0; i < fast.mapCount(); ++i) {
       const ShadowMaps::Map& a = fast.mapAt(i);
       const ShadowMaps::Map& b = slow.mapAt(i);
-      for (uint32_t o : a.depth.owner) planeBlocks += o != kBlockClear && o != kBlockKeys;
+      for (uint32_t o : a.depth.owner) planeBlocks += BlockDepthMap::isPlane(o);
       for (int y = 0; y < options.shadowMapSize; ++y)
         for (int x = 0; x < options.shadowMapSize; ++x)
           ASSERT_EQ(a.depth.key(x, y), b.depth.key(x, y))
