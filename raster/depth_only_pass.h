@@ -17,7 +17,8 @@
 // being cleared, and a triangle that covers a block whole and is nearer
 // than everything the block holds takes it as a plane (the triangle's
 // setup index, no keys computed) when its four corner keys prove it
-// (blockKeyRange below). A block's keys are computed into the buffer only
+// (Avx2Row::keyRange; the first triangle covering a whole tile takes its
+// 64 blocks at once). A block's keys are computed into the buffer only
 // when a triangle draws part of it or meets its plane. The map keeps the
 // same three states per block (BlockDepthMap): clear, a plane, or keys;
 // only the blocks of keys are written to memory, and a lookup of a plane
@@ -86,9 +87,10 @@ using AlphaTestFunction = std::function<bool(const TriangleSetup&, int px, int p
 // that prove it.
 enum class SimdLevel { Best, Avx2, Baseline };
 
-// A block of a tile or map (kCoverageBlock² texels) holds one of: nothing
-// drawn (every key kClearDepthKey), the keys of one triangle's depth plane
-// (the setup's index), or keys stored texel by texel.
+// A block of a tile (kCoverageBlock² texels) holds one of: nothing drawn
+// (kBlockClear: every key kClearDepthKey), the keys of one triangle's
+// depth plane (the setup's index), or keys stored texel by texel
+// (kBlockKeys; in a BlockDepthMap, kBlockSlot | slot).
 constexpr uint32_t kBlockClear = 0xFFFFFFFFu;
 constexpr uint32_t kBlockKeys = 0xFFFFFFFEu;
 // Blocks per tile (kTileSize / kCoverageBlock squared).
