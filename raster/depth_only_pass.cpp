@@ -1,6 +1,7 @@
 #include "raster/depth_only_pass.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <string>
@@ -216,6 +217,48 @@ struct Avx2Row {
     return pass;
   }
 
+  // The smallest and largest key of `plane` over the 8×8 block at (bx, by)
+  // (samples at offsetX, offsetY within the texels), float formats, from
+  // its four corners; false where the corners cannot prove it (a corner's
+  // depth not finite or not above 0). Why the corners suffice: a texel's
+  // depth is column[i] + rowTerm(j), and every operation of both terms
+  // (planeColumnTerms, planeRowTerm, computed here lane by lane with the
+  // same operations) and of the sum is a rounded IEEE operation with one
+  // varying operand, monotonic in it; so the depth is monotonic along
+  // each row and each column and lies between its corners' values: finite
+  // and above 0 (no NaN, no −0). The clamp, the conversion to float and
+  // the key are monotonic too, so the keys' extremes are the corners'.
+  // The same over the n × n texels at (bx, by) (a block, n = 8, or a tile).
+  __attribute__((target("avx2"))) static bool keyRange(bool reversed, const Plane& p, int bx, double offsetX,
+                                                       int by, double offsetY, uint32_t* lo, uint32_t* hi,
+                                                       int n = B) {
+    // Lanes: columns bx and bx + n − 1, rows by and by + n − 1.
+    const __m256d at = _mm256_setr_pd(double(bx), double(bx + n - 1), double(by), double(by + n - 1));
+    const __m256d offset = _mm256_setr_pd(offsetX, offsetX, offsetY, offsetY);
+    const __m256d origin = _mm256_setr_pd(p.x0, p.x0, p.y0, p.y0);
+    const __m256d slope = _mm256_setr_pd(p.dx, p.dx, p.dy, p.dy);
+    const __m256d terms = _mm256_mul_pd(slope, _mm256_sub_pd(_mm256_add_pd(at, offset), origin));
+    const __m128d column = _mm_add_pd(_mm_set1_pd(p.v0), _mm256_castpd256_pd128(terms));  // c0, c7
+    const __m128d row = _mm256_extractf128_pd(terms, 1);                                  // r0, r7
+    // (c0 + r0, c7 + r0, c0 + r7, c7 + r7)
+    const __m256d z = _mm256_add_pd(_mm256_set_m128d(column, column),
+                                    _mm256_set_m128d(_mm_unpackhi_pd(row, row), _mm_unpacklo_pd(row, row)));
+    const __m256d absZ = _mm256_andnot_pd(_mm256_set1_pd(-0.0), z);
+    const __m256d ok = _mm256_and_pd(_mm256_cmp_pd(z, _mm256_setzero_pd(), _CMP_GT_OQ),
+                                     _mm256_cmp_pd(absZ, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OQ));
+    if (_mm256_movemask_pd(ok) != 0xF) return false;
+    // depthKey: clamp (z > 0: the upper bound only), float, key.
+    const __m128i bits = _mm_castps_si128(_mm256_cvtpd_ps(_mm256_min_pd(_mm256_set1_pd(1.0), z)));
+    const __m128i keys = reversed ? _mm_sub_epi32(_mm_set1_epi32(0x3F800000), bits) : bits;
+    __m128i mn = _mm_min_epu32(keys, _mm_shuffle_epi32(keys, _MM_SHUFFLE(1, 0, 3, 2)));
+    __m128i mx = _mm_max_epu32(keys, _mm_shuffle_epi32(keys, _MM_SHUFFLE(1, 0, 3, 2)));
+    mn = _mm_min_epu32(mn, _mm_shuffle_epi32(mn, _MM_SHUFFLE(2, 3, 0, 1)));
+    mx = _mm_max_epu32(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(2, 3, 0, 1)));
+    *lo = uint32_t(_mm_cvtsi128_si32(mn));
+    *hi = uint32_t(_mm_cvtsi128_si32(mx));
+    return true;
+  }
+
   // A whole 8×8 block the triangle covers, float formats, no alpha test:
   // each row's keys, test and write as operator() computes them (the same
   // column terms, planeRowTerm, clamp, conversion and compare, so the same
@@ -289,6 +332,32 @@ struct Avx512Row : Avx2Row {
 #pragma GCC diagnostic pop
 #endif
 
+// Computes block hb's keys into the buffer `keys` (rows of kTileSize) from
+// its state: the clear key, or its plane's keys at the samples (the bits
+// of the kernels' keys: planeRowKeys).
+__attribute__((always_inline)) inline void loadBlock(int32_t* keys, const TileRect& rect, int columns,
+                                                     DepthOnlyTile::Blocks& state, size_t hb,
+                                                     const std::vector<TriangleSetup>& setups,
+                                                     DepthFormat format, const glm::dvec2& pos) {
+  const int bx = int(hb % size_t(columns)) * B, by = int(hb / size_t(columns)) * B;
+  const int rows = std::min(B, rect.y1 - rect.y0 - by);
+  int32_t* row = keys + size_t(by) * kTileSize + size_t(bx);
+  const uint32_t owner = state.owner[hb];
+  if (owner == kBlockClear) {
+    for (int j = 0; j < rows; ++j, row += kTileSize) std::fill_n(row, B, kClearBiased);
+  } else {
+    const Plane& plane = setups[owner].depth;
+    double column[8];
+    planeColumnTerms(plane, rect.x0 + bx, pos.x, column);
+    for (int j = 0; j < rows; ++j, row += kTileSize) {
+      uint32_t k[8];
+      planeRowKeys(format, column, planeRowTerm(plane, rect.y0 + by + j, pos.y), k);
+      for (int i = 0; i < B; ++i) row[i] = int32_t(k[i] ^ kBias);
+    }
+  }
+  state.inBuffer |= uint64_t(1) << hb;
+}
+
 // drawFast<Avx2Row> passes AVX vectors between functions compiled without
 // AVX, which GCC warns changes the ABI; it is always inlined into drawAvx2
 // (AVX2), so no such call exists.
@@ -298,7 +367,8 @@ struct Avx512Row : Avx2Row {
 // kTileSize), rows of full blocks through `kernel`. Inlined into each
 // kernel's entry point, so that its ISA covers the whole loop.
 template <typename Row>
-__attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRect& rect,
+__attribute__((always_inline)) inline void drawFast(int32_t* keys, DepthOnlyTile::Blocks& state,
+                                                    const TileRect& rect,
                                                     const std::vector<TriangleSetup>& setups,
                                                     const std::vector<uint32_t>& bin, const SampleGrid& grid,
                                                     DepthFormat format, const AlphaTestFunction& alphaTest,
@@ -318,12 +388,40 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
   uint64_t mask = 0;
   uint64_t tested = 0, passed = 0;
 
+  // Blocks taken as a plane with a whole tile, whose key range (blockMax,
+  // minKey) is computed when a later triangle first meets the block.
+  uint64_t rangeUnknown = 0;
+  const bool wholeTiles = Row::kFullBlock && !alphaTest && rect.x1 - rect.x0 == kTileSize &&
+                          rect.y1 - rect.y0 == kTileSize &&
+                          (format == DepthFormat::FloatReversed || format == DepthFormat::Float);
+
   for (uint32_t index : bin) {
     const TriangleSetup& t = setups[index];
     const PixelBounds r = boundsIn(t, rect);
     if (r.empty()) continue;
     counters->coverageTests += r.samples(1);
     prepareOffsets(t, grid, scratch);
+    if constexpr (Row::kFullBlock) {
+      // The first triangle drawn covering the whole tile, nearer than the
+      // clear key everywhere: every block becomes its plane at once (what
+      // the blocks' claims below would do one by one, counters included).
+      if (wholeTiles && state.inBuffer == 0 && rangeUnknown == 0 &&
+          std::all_of(state.owner, state.owner + kTileBlocks, [](uint32_t o) { return o == kBlockClear; })) {
+        int64_t lo[3];
+        uint32_t low, high;
+        if (classifyBlock(t, scratch, U, PixelBlock{rect.x0, rect.y0, kTileSize, kTileSize}, lo) ==
+                BlockClass::Accept &&
+            Row::keyRange(format == DepthFormat::FloatReversed, t.depth, rect.x0, pos.x, rect.y0, pos.y, &low,
+                          &high, kTileSize) &&
+            high < kClearDepthKey) {
+          std::fill_n(state.owner, kTileBlocks, index);
+          rangeUnknown = ~uint64_t(0);
+          tested += uint64_t(kTileSize) * kTileSize;
+          passed += uint64_t(kTileSize) * kTileSize;
+          continue;
+        }
+      }
+    }
     const uint32_t triangleKey = minKeyOverTriangle(t, format, U);
     const RowContext ctx{format, alphaTest, t, counters};
     for (int by = rect.y0 + (r.y0 - rect.y0) / B * B; by <= r.y1; by += B)
@@ -335,24 +433,61 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
         const BlockClass c = classifyBlock(t, scratch, U, b, lo);
         if (c == BlockClass::Reject) continue;
         const size_t hb = size_t((by - rect.y0) / B) * size_t(columns) + size_t((bx - rect.x0) / B);
+        if constexpr (Row::kFullBlock) {
+          if ((rangeUnknown >> hb) & 1u) {
+            // The tile's range proved the block's corners finite and above 0.
+            uint32_t low = 0, high = 0;
+            const bool known =
+                Row::keyRange(format == DepthFormat::FloatReversed, setups[state.owner[hb]].depth, bx, pos.x,
+                              by, pos.y, &low, &high);
+            RASTRAY_CHECK(known, "a block of a tile's plane has its key range");
+            state.minKey[hb] = low;
+            blockMax[hb] = high;
+            rangeUnknown &= ~(uint64_t(1) << hb);
+          }
+        }
         // Hierarchical test: behind every stored key of the block.
         if (blockMax[hb] != kClearDepthKey &&
             std::max(triangleKey, minKeyOverBlock(t, format, b, pos, pos)) > blockMax[hb])
           continue;
+        const uint64_t bit = uint64_t(1) << hb;
         if constexpr (Row::kFullBlock) {
           if (c == BlockClass::Accept && b.x == bx && b.y == by && b.w == B && b.h == B && !alphaTest &&
               (format == DepthFormat::FloatReversed || format == DepthFormat::Float)) {
             tested += uint64_t(B * B);
+            if (!(state.inBuffer & bit)) {
+              // Clear or another plane, not in the buffer: t takes the
+              // block as its plane when its largest key is below the
+              // block's smallest (every texel passes and holds t's key).
+              uint32_t low, high;
+              if (Row::keyRange(format == DepthFormat::FloatReversed, t.depth, bx, pos.x, by, pos.y, &low,
+                                &high) &&
+                  high < (state.owner[hb] == kBlockClear ? kClearDepthKey : state.minKey[hb])) {
+                state.owner[hb] = index;
+                state.minKey[hb] = low;
+                blockMax[hb] = high;
+                passed += uint64_t(B * B);
+                continue;
+              }
+              loadBlock(keys, rect, columns, state, hb, setups, format, pos);
+            }
             double column[8];
             planeColumnTerms(t.depth, bx, pos.x, column);
             int32_t* row = keys + size_t(by - rect.y0) * kTileSize + size_t(bx - rect.x0);
             int32_t m;
-            passed +=
+            const uint32_t n =
                 Row::fullBlock(format == DepthFormat::FloatReversed, column, t.depth, by, pos.y, row, &m);
+            passed += n;
             blockMax[hb] = uint32_t(m) ^ kBias;
+            // Every texel written: the block is t's plane (its keys also in the buffer).
+            if (n == uint32_t(B * B))
+              state.owner[hb] = index;
+            else if (n != 0)
+              state.owner[hb] = kBlockKeys;
             continue;
           }
         }
+        if (!(state.inBuffer & bit)) loadBlock(keys, rect, columns, state, hb, setups, format, pos);
         if (c == BlockClass::Accept)
           mask = fullBlockMask(b);
         else
@@ -386,6 +521,7 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
           passes |= uint64_t(pass) << (8 * j);
         }
         passed += uint64_t(bitCount(passes));
+        if (passes != 0) state.owner[hb] = kBlockKeys;
         // The block's exact largest key: the rows not drawn as well.
         for (int j = 0; j < bh; ++j) {
           if ((drawnRows >> j) & 1u) continue;
@@ -405,20 +541,21 @@ __attribute__((always_inline)) inline void drawFast(int32_t* keys, const TileRec
 #pragma GCC diagnostic pop
 
 #if defined(__SSE2__)
-void drawSse2(int32_t* keys, const TileRect& rect, const std::vector<TriangleSetup>& setups,
-              const std::vector<uint32_t>& bin, const SampleGrid& grid, DepthFormat format,
-              const AlphaTestFunction& alphaTest, DepthPassCounters* counters) {
-  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Sse2Row{});
+void drawSse2(int32_t* keys, DepthOnlyTile::Blocks& state, const TileRect& rect,
+              const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
+              const SampleGrid& grid, DepthFormat format, const AlphaTestFunction& alphaTest,
+              DepthPassCounters* counters) {
+  drawFast(keys, state, rect, setups, bin, grid, format, alphaTest, counters, Sse2Row{});
 }
 #endif
 
 #if defined(RASTRAY_DEPTH_ONLY_AVX2)
-__attribute__((target("avx2"))) void drawAvx2(int32_t* keys, const TileRect& rect,
-                                              const std::vector<TriangleSetup>& setups,
+__attribute__((target("avx2"))) void drawAvx2(int32_t* keys, DepthOnlyTile::Blocks& state,
+                                              const TileRect& rect, const std::vector<TriangleSetup>& setups,
                                               const std::vector<uint32_t>& bin, const SampleGrid& grid,
                                               DepthFormat format, const AlphaTestFunction& alphaTest,
                                               DepthPassCounters* counters) {
-  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Avx2Row{});
+  drawFast(keys, state, rect, setups, bin, grid, format, alphaTest, counters, Avx2Row{});
 }
 
 bool hasAvx2() {
@@ -426,27 +563,17 @@ bool hasAvx2() {
   return yes;
 }
 
-__attribute__((target("avx2,avx512f,avx512vl"))) void drawAvx512(int32_t* keys, const TileRect& rect,
-                                                                 const std::vector<TriangleSetup>& setups,
-                                                                 const std::vector<uint32_t>& bin,
-                                                                 const SampleGrid& grid, DepthFormat format,
-                                                                 const AlphaTestFunction& alphaTest,
-                                                                 DepthPassCounters* counters) {
-  drawFast(keys, rect, setups, bin, grid, format, alphaTest, counters, Avx512Row{});
+__attribute__((target("avx2,avx512f,avx512vl"))) void drawAvx512(
+    int32_t* keys, DepthOnlyTile::Blocks& state, const TileRect& rect,
+    const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin, const SampleGrid& grid,
+    DepthFormat format, const AlphaTestFunction& alphaTest, DepthPassCounters* counters) {
+  drawFast(keys, state, rect, setups, bin, grid, format, alphaTest, counters, Avx512Row{});
 }
 
 bool hasAvx512() {
   static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("avx512f") &&
                           __builtin_cpu_supports("avx512vl");
   return yes;
-}
-
-// The tile buffer's clear and its rows' streaming out, 32 bytes a store
-// (a 2048² cube map clears and writes 100 MB a frame; 16-byte stores were
-// about a tenth of the map pass).
-__attribute__((target("avx2"))) void clearAvx2(int32_t* keys, size_t n) {
-  const __m256i clear = _mm256_set1_epi32(kClearBiased);
-  for (size_t i = 0; i < n; i += 8) _mm256_store_si256(reinterpret_cast<__m256i*>(keys + i), clear);
 }
 
 // Streams src[i] ^ kBias into dst for the leading multiple of 8 of
@@ -521,10 +648,33 @@ DepthMap::DepthMap(int w, int h) : width(w), height(h) {
   keys = std::unique_ptr<uint32_t[], DepthMapRelease>(static_cast<uint32_t*>(p), DepthMapRelease{allocated});
 }
 
-DepthOnlyTile::DepthOnlyTile(const TileRect& rect) : rect_(rect) {
+BlockDepthMap::BlockDepthMap(int w, int h, DepthFormat f, const glm::dvec2& samplePosition)
+    : width(w),
+      height(h),
+      blocksX((w + B - 1) / B),
+      format(f),
+      sample(samplePosition),
+      keys(blocksX * B, (h + B - 1) / B * B),
+      owner(size_t(blocksX) * size_t((h + B - 1) / B), kBlockClear) {}
+
+void BlockDepthMap::keepPlanes(const std::vector<TriangleSetup>& setups) {
+  std::vector<uint32_t> renumbered(setups.size(), kBlockClear);
+  planes.clear();
+  for (uint32_t& o : owner) {
+    if (!isPlane(o)) continue;
+    if (renumbered[o] == kBlockClear) {
+      renumbered[o] = uint32_t(planes.size());
+      planes.push_back(setups[o].depth);
+    }
+    o = renumbered[o];
+  }
+}
+
+DepthOnlyTile::DepthOnlyTile(const TileRect& rect) : rect_(rect), columns_((rect.x1 - rect.x0 + B - 1) / B) {
   RASTRAY_CHECK(rect.x1 - rect.x0 <= kTileSize && rect.y1 - rect.y0 <= kTileSize && rect.x0 <= rect.x1 &&
                     rect.y0 <= rect.y1,
                 "a depth-only tile is at most " + std::to_string(kTileSize) + " texels square");
+  std::fill_n(blocks_.owner, kTileBlocks, kBlockClear);
 }
 
 void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
@@ -533,25 +683,20 @@ void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::
   RASTRAY_CHECK(grid.spp == 1,
                 "the depth-only pass takes 1 sample per texel, not " + std::to_string(grid.spp));
   const TileRect& rect = rect_;
-  const int height = rect.y1 - rect.y0;
-  // Clear the rows in use, whole (GCC 12 does not vectorise loops at -O2:
-  // a scalar fill here cost as much as a sixth of the drawing).
-#if defined(RASTRAY_DEPTH_ONLY_AVX2)
-  if (hasAvx2()) {
-    clearAvx2(keys_, size_t(height) * kTileSize);  // rows of kTileSize: a multiple of 8
-  } else {
-    const __m128i clear = _mm_set1_epi32(kClearBiased);
-    for (size_t i = 0; i < size_t(height) * kTileSize; i += 4)
-      _mm_store_si128(reinterpret_cast<__m128i*>(&keys_[i]), clear);
-  }
-#elif defined(__SSE2__)
-  const __m128i clear = _mm_set1_epi32(kClearBiased);
-  for (size_t i = 0; i < size_t(height) * kTileSize; i += 4)
-    _mm_store_si128(reinterpret_cast<__m128i*>(&keys_[i]), clear);
-#else
-  std::fill_n(keys_, size_t(height) * kTileSize, kClearBiased);
-#endif
+  setups_ = &setups;
+  format_ = format;
+  sample_ = grid.positions[0];
+  // Every block starts clear, its keys not in the buffer: the buffer is
+  // cleared block by block when a triangle first draws part of a block.
+  std::fill_n(blocks_.owner, kTileBlocks, kBlockClear);
+  blocks_.inBuffer = 0;
   if (path == CoveragePath::Reference) {
+    // The whole buffer cleared, every block held as keys.
+    const int height = rect.y1 - rect.y0;
+    std::fill_n(keys_, size_t(height) * kTileSize, kClearBiased);
+    const int blocks = columns_ * ((height + B - 1) / B);
+    std::fill_n(blocks_.owner, blocks, kBlockKeys);
+    blocks_.inBuffer = blocks == 64 ? ~uint64_t(0) : (uint64_t(1) << blocks) - 1;
     CoverageScratch scratch;
     for (uint32_t index : bin) {
       const TriangleSetup& t = setups[index];
@@ -573,26 +718,49 @@ void DepthOnlyTile::render(const std::vector<TriangleSetup>& setups, const std::
   }
 #if defined(RASTRAY_DEPTH_ONLY_AVX2)
   if (simd == SimdLevel::Best && hasAvx512()) {
-    drawAvx512(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+    drawAvx512(keys_, blocks_, rect, setups, bin, grid, format, alphaTest, counters);
     return;
   }
   if (simd != SimdLevel::Baseline && hasAvx2()) {
-    drawAvx2(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+    drawAvx2(keys_, blocks_, rect, setups, bin, grid, format, alphaTest, counters);
     return;
   }
 #endif
   (void)simd;
 #if defined(__SSE2__)
-  drawSse2(keys_, rect, setups, bin, grid, format, alphaTest, counters);
+  drawSse2(keys_, blocks_, rect, setups, bin, grid, format, alphaTest, counters);
 #else
-  drawFast(keys_, rect, setups, bin, grid, format, alphaTest, counters, ScalarRow{});
+  drawFast(keys_, blocks_, rect, setups, bin, grid, format, alphaTest, counters, ScalarRow{});
 #endif
 }
 
+void DepthOnlyTile::loadAll() {
+  const int blocks = columns_ * ((rect_.y1 - rect_.y0 + B - 1) / B);
+  for (int hb = 0; hb < blocks; ++hb)
+    if (!((blocks_.inBuffer >> hb) & 1u))
+      loadBlock(keys_, rect_, columns_, blocks_, size_t(hb), *setups_, format_, sample_);
+}
+
+int DepthOnlyTile::planeBlocks() const {
+  const int blocks = columns_ * ((rect_.y1 - rect_.y0 + B - 1) / B);
+  int n = 0;
+  for (int hb = 0; hb < blocks; ++hb)
+    n += blocks_.owner[hb] != kBlockClear && blocks_.owner[hb] != kBlockKeys;
+  return n;
+}
+
 void DepthOnlyTile::store(DepthMap* map) const {
+  // Every block's keys: a copy of the tile with the missing blocks loaded.
+  DepthOnlyTile full = *this;
+  if (setups_)
+    full.loadAll();
+  else {
+    const int height = rect_.y1 - rect_.y0;
+    std::fill_n(full.keys_, size_t(height) * kTileSize, kClearBiased);
+  }
   const int width = rect_.x1 - rect_.x0;
   for (int y = rect_.y0; y < rect_.y1; ++y) {
-    const int32_t* src = &keys_[size_t(y - rect_.y0) * kTileSize];
+    const int32_t* src = &full.keys_[size_t(y - rect_.y0) * kTileSize];
     uint32_t* dst = &map->keys[map->index(rect_.x0, y)];
     int i = 0;
 #if defined(__SSE2__)
@@ -610,6 +778,46 @@ void DepthOnlyTile::store(DepthMap* map) const {
 #endif
     for (; i < width; ++i) dst[i] = uint32_t(src[i]) ^ kBias;
   }
+#if defined(__SSE2__)
+  _mm_sfence();  // streaming stores are weakly ordered: publish them before the task completes
+#endif
+}
+
+void DepthOnlyTile::store(BlockDepthMap* map) const {
+  const int height = rect_.y1 - rect_.y0;
+  const int rowsOfBlocks = (height + B - 1) / B;
+  const int blocks = columns_ * rowsOfBlocks;
+  int withKeys = 0;
+  for (int hb = 0; hb < blocks; ++hb) withKeys += blocks_.owner[hb] == kBlockKeys;
+  uint32_t slot = withKeys ? __atomic_fetch_add(&map->slotsUsed, uint32_t(withKeys), __ATOMIC_RELAXED) : 0;
+  const size_t first = size_t(rect_.y0 / B) * size_t(map->blocksX) + size_t(rect_.x0 / B);
+  for (int j = 0; j < rowsOfBlocks; ++j)
+    for (int i = 0; i < columns_; ++i) {
+      const size_t hb = size_t(j) * size_t(columns_) + size_t(i);
+      uint32_t& owner = map->owner[first + size_t(j) * size_t(map->blocksX) + size_t(i)];
+      owner = blocks_.owner[hb];
+      if (owner != kBlockKeys) continue;
+      owner = kBlockSlot | slot;
+      // The block's 64 keys in 256 contiguous bytes: whole cache lines,
+      // streamed where the build allows (lanes and rows beyond the rect are
+      // never read).
+      uint32_t* dst = &map->keys.keys[size_t(slot) * 64];
+      const int32_t* src = &keys_[size_t(j * B) * kTileSize + size_t(i * B)];
+      const int bh = std::min(B, height - j * B);
+      for (int y = 0; y < B; ++y, dst += B) {
+        const int32_t* row = src + size_t(std::min(y, bh - 1)) * kTileSize;  // rows below the rect: any
+#if defined(__SSE2__)
+        const __m128i bias = _mm_set1_epi32(int32_t(kBias));
+        _mm_stream_si128(reinterpret_cast<__m128i*>(dst),
+                         _mm_xor_si128(_mm_load_si128(reinterpret_cast<const __m128i*>(row)), bias));
+        _mm_stream_si128(reinterpret_cast<__m128i*>(dst + 4),
+                         _mm_xor_si128(_mm_load_si128(reinterpret_cast<const __m128i*>(row + 4)), bias));
+#else
+        for (int x = 0; x < B; ++x) dst[x] = uint32_t(row[x]) ^ kBias;
+#endif
+      }
+      ++slot;
+    }
 #if defined(__SSE2__)
   _mm_sfence();  // streaming stores are weakly ordered: publish them before the task completes
 #endif

@@ -100,34 +100,17 @@ ShadowMaps::Lookup lookupOf(const Camera& camera, const ClipSpace& space) {
   return k;
 }
 
-// Concatenates the tiles' sorted fragments in tile order and indexes
-// them by tile row (Map::attenuationRows); the tiles in parallel, each
-// from its offset in the concatenation.
-void indexAttenuation(const std::vector<std::vector<ShadowMaps::Attenuation>>& perTile,
-                      ShadowMaps::Map* map) {
-  // The copy first, serially at memory speed (resize() would zero the
-  // storage first, and a per-fragment push_back with the row bookkeeping
-  // cost more than the copy), then the rows' starts in parallel.
-  std::vector<size_t> offset(perTile.size() + 1, 0);
-  for (size_t tile = 0; tile < perTile.size(); ++tile) offset[tile + 1] = offset[tile] + perTile[tile].size();
-  map->attenuation.reserve(offset.back());
-  for (const auto& v : perTile) map->attenuation.insert(map->attenuation.end(), v.begin(), v.end());
-  map->attenuationRows.assign(perTile.size() * size_t(kTileSize) + 1, 0);
-  const size_t width = size_t(map->depth.width);
-  parallelFor(0, int(perTile.size()), [&](int t) {
-    const size_t tile = size_t(t);
-    const size_t y0 = size_t(map->tiles.rect(t).y0);
-    uint32_t* rows = &map->attenuationRows[tile * size_t(kTileSize)];
-    size_t at = offset[tile];
-    size_t next = 0;  // the next row of the tile whose start is not yet set
-    for (const ShadowMaps::Attenuation& a : perTile[tile]) {
-      const size_t row = a.texel / width - y0;
-      for (; next <= row; ++next) rows[next] = uint32_t(at);
-      ++at;
-    }
-    for (; next < size_t(kTileSize); ++next) rows[next] = uint32_t(at);
-  });
-  map->attenuationRows.back() = uint32_t(map->attenuation.size());
+// Indexes a tile's sorted fragments by row: rows[r] is the first
+// fragment of the tile's row r (kTileSize + 1 entries, the last the
+// size), `y0` the tile's first row, `width` the map's.
+void indexTileRows(const std::vector<ShadowMaps::Attenuation>& fragments, size_t y0, size_t width,
+                   uint32_t* rows) {
+  size_t next = 0;  // the next row of the tile whose start is not yet set
+  for (size_t at = 0; at < fragments.size(); ++at) {
+    const size_t row = fragments[at].texel / width - y0;
+    for (; next <= row; ++next) rows[next] = uint32_t(at);
+  }
+  for (; next <= size_t(kTileSize); ++next) rows[next] = uint32_t(fragments.size());
 }
 
 // The receiver's normal in the map's view frame (the rotation of
@@ -279,7 +262,13 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
     for (size_t f = 0; f < cameras.size(); ++f) {
       const Camera& c = cameras[f];
       const SampleGrid grid = makeSampleGrid(1, size, size);
-      Map map{c, makeClipSpace(c, grid.guardPixels), {}, DepthMap(size, size), TileGrid(size, size), {}, {}};
+      Map map{c,
+              makeClipSpace(c, grid.guardPixels),
+              {},
+              BlockDepthMap(size, size, kMapFormat, grid.positions[0]),
+              TileGrid(size, size),
+              {},
+              {}};
       map.lookup = lookupOf(map.camera, map.space);
       if (cube && faces.empty()) faces = cubeFaceCandidates(scene, light.position, map.space.scale.x, size);
       DepthSettings ds{
@@ -316,15 +305,17 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
           if (m.alphaMode != AlphaMode::Mask) return true;
           return shader->coverageAlpha(surfaceAt(t, px, py, s), TextureFootprint{}) >= m.alphaCutoff;
         };
-      std::vector<std::vector<Attenuation>> perTile(size_t(tiles.count()));
+      map.attenuation.resize(size_t(tiles.count()));
+      map.attenuationRows.resize(size_t(tiles.count()) * size_t(kTileSize + 1));
       parallelFor(0, tiles.count(), [&](int tile) {
         if (stopRequested(options.cancel)) return;  // Ctrl-C or cancelled: thrown below
         DepthPassCounters dc;
         const TileRect rect = tiles.rect(tile);
         DepthOnlyTile depth(rect);
         depth.render(setups, bins[size_t(tile)], grid, kMapFormat, alphaTest, &dc, path);
+        if (!transmissiveBins[size_t(tile)].empty()) depth.loadAll();  // key() below reads the buffer
         // Attenuating fragments in front of the opaque depth, kept per texel.
-        std::vector<Attenuation>& found = perTile[size_t(tile)];
+        std::vector<Attenuation>& found = map.attenuation[size_t(tile)];
         CoverageScratch scratch;
         for (uint32_t index : transmissiveBins[size_t(tile)]) {
           const TriangleSetup& t = setups[index];
@@ -346,10 +337,12 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         depth.store(&map.depth);
         // By (texel, key); stable: equal keys keep the order met.
         sortTileFragments(rect, size_t(map.depth.width), &found);
+        indexTileRows(found, size_t(rect.y0), size_t(map.depth.width),
+                      &map.attenuationRows[size_t(tile) * size_t(kTileSize + 1)]);
       });
       throwIfStopped(options.cancel);
-      indexAttenuation(perTile, &map);
-      attenuating_ += map.attenuation.size();
+      map.depth.keepPlanes(setups);
+      for (const auto& v : map.attenuation) attenuating_ += v.size();
       perLight_[l].push_back(std::move(map));
     }
   }
@@ -371,11 +364,11 @@ glm::vec3 ShadowMaps::litReference(const Map& map, const glm::dvec3& world, cons
   const double z = windowDepth(kMapFormat, map.camera.projection, map.camera.znear, map.camera.zfar, d);
   const uint32_t key = depthKey(kMapFormat, z);
   const uint32_t texel = uint32_t(map.depth.index(x, y));
-  if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
+  if (key > map.depth.key(x, y)) return glm::vec3(0.0f);
   // Attenuation by the transmissive layers between the light and the point.
   const size_t tile = size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize);
-  const auto first = map.attenuation.begin() + map.attenuationRows[tile * kTileSize];
-  const auto last = map.attenuation.begin() + map.attenuationRows[(tile + 1) * kTileSize];
+  const auto first = map.attenuation[tile].begin();
+  const auto last = map.attenuation[tile].end();
   glm::vec3 t = one;
   auto it =
       std::lower_bound(first, last, texel, [](const Attenuation& a, uint32_t tx) { return a.texel < tx; });
@@ -411,15 +404,15 @@ glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world, const glm::dv
     z = k.znear * (k.zfar - dc) / (dc * (k.zfar - k.znear));
   const uint32_t key = depthKey(kMapFormat, z);
   const uint32_t texel = uint32_t(map.depth.index(x, y));
-  if (key > map.depth.keys[texel]) return glm::vec3(0.0f);
+  if (key > map.depth.key(x, y)) return glm::vec3(0.0f);
   // Attenuation by the transmissive layers between the light and the point:
   // only the fragments of the texel's row within its tile are searched.
-  const size_t slot = (size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize)) * kTileSize +
-                      size_t(y % kTileSize);
+  const size_t tile = size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize);
+  const size_t slot = tile * (kTileSize + 1) + size_t(y % kTileSize);
   const uint32_t first = map.attenuationRows[slot], last = map.attenuationRows[slot + 1];
   glm::vec3 t = one;
   if (first == last) return t;
-  const Attenuation* a = map.attenuation.data();
+  const Attenuation* a = map.attenuation[tile].data();
   const Attenuation* it = std::lower_bound(a + first, a + last, texel,
                                            [](const Attenuation& f, uint32_t tx) { return f.texel < tx; });
   for (; it != a + last && it->texel == texel && it->key < key; ++it) t *= it->transmittance;
@@ -465,7 +458,7 @@ void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMap
       for (size_t j = i; j > first && sorted[j].key < sorted[j - 1].key; --j)
         std::swap(sorted[j], sorted[j - 1]);
   }
-  std::copy(sorted.begin(), sorted.end(), v.begin());
+  v.swap(sorted);  // the thread keeps the unsorted buffer for its next tile: no copy back
 }
 
 const ShadowMaps::Map& ShadowMaps::mapAt(size_t i) const { return *maps_.at(i); }

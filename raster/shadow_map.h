@@ -25,10 +25,12 @@
 //
 // Speed. The opaque depth runs the depth-only pass (depth_only_pass.h:
 // the camera pass's block coverage and hierarchical depth, SIMD keys, a
-// tile-local buffer streamed into the map), with the same keys as the
-// camera pass's keys-only rasterDepthPass. A lookup costs a few double
-// operations (the reference's, inlined: same bits) and one load from the
-// map, which at 1024² (4 MB a face) misses the caches for many shaded samples; the
+// tile-local buffer, 8×8 blocks kept as a triangle's plane where one
+// covers them whole), with the same keys as the camera pass's keys-only
+// rasterDepthPass. A map is stored by blocks (BlockDepthMap): a lookup
+// costs a few double operations (the reference's, inlined: same bits),
+// one load from the blocks' table (256 KB a 2048² face) and either the
+// block's plane evaluated at the texel or one load of its keys; the
 // transmissive fragments are indexed by tile row, so a texel without any
 // costs one more load and no search.
 #pragma once
@@ -124,14 +126,15 @@ class ShadowMaps : public LightVisibility {
     Camera camera;
     ClipSpace space;
     Lookup lookup;
-    DepthMap depth;
+    BlockDepthMap depth;  // by 8×8 blocks: clear, a plane or keys
     TileGrid tiles{0, 0};
-    // The transmissive fragments in front of the opaque depth: by tile,
-    // then (texel, key); equal keys at a texel in the order the pass met
+    // The transmissive fragments in front of the opaque depth, per tile
+    // (each tile's own vector, as its task sorted it: no copy into one),
+    // by (texel, key); equal keys at a texel in the order the pass met
     // them (bin order, then texel order).
-    std::vector<Attenuation> attenuation;
-    // Per tile and row within it (tile · kTileSize + row): the first
-    // fragment of that row of the tile; one more entry ends the last tile.
+    std::vector<std::vector<Attenuation>> attenuation;
+    // Per tile, kTileSize + 1 entries (tile · (kTileSize + 1) + row): the
+    // first fragment of each row of the tile in its vector, then its size.
     std::vector<uint32_t> attenuationRows;
   };
 

@@ -154,6 +154,8 @@ const AlphaTestFunction kAlpha = [](const TriangleSetup& t, int x, int y, int s)
 
 struct Maps {
   std::vector<uint32_t> keys;
+  std::vector<uint32_t> blockKeys;  // the same tiles stored by blocks (BlockDepthMap::key)
+  int planeBlocks = 0;              // blocks the tiles held as a plane
   DepthPassCounters counters;
 };
 
@@ -167,19 +169,29 @@ std::vector<TriangleSetup> setupFor(const Scene& scene, const Camera& camera, co
 }
 
 // The depth-only pass over every tile of a map filled with garbage first
-// (the pass must write every texel).
+// (the pass must write every texel), stored texel by texel and by blocks
+// (whose keys are garbage too where no block of keys was stored).
 Maps depthOnly(const std::vector<TriangleSetup>& setups, const SampleGrid& grid, int w, int h,
                DepthFormat format, const AlphaTestFunction& alpha, CoveragePath path,
                SimdLevel simd = SimdLevel::Best) {
   DepthMap map(w, h);
   std::fill_n(map.keys.get(), size_t(w) * size_t(h), 0x5A5A5A5Au);
+  BlockDepthMap blocks(w, h, format, grid.positions[0]);
+  std::fill_n(blocks.keys.keys.get(), size_t(w) * size_t(h), 0x5A5A5A5Au);
   const TileGrid tiles(w, h);
   const auto bins = binTriangles(tiles, grid, setups, [](const TriangleSetup&) { return true; });
   Maps out;
-  for (int tile = 0; tile < tiles.count(); ++tile)
-    rasterDepthOnlyPass(setups, bins[size_t(tile)], grid, tiles.rect(tile), format, alpha, &map,
-                        &out.counters, path, simd);
+  for (int tile = 0; tile < tiles.count(); ++tile) {
+    DepthOnlyTile t(tiles.rect(tile));
+    t.render(setups, bins[size_t(tile)], grid, format, alpha, &out.counters, path, simd);
+    t.store(&map);
+    t.store(&blocks);
+    out.planeBlocks += t.planeBlocks();
+  }
+  blocks.keepPlanes(setups);
   out.keys.assign(map.keys.get(), map.keys.get() + size_t(w) * size_t(h));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) out.blockKeys.push_back(blocks.key(x, y));
   return out;
 }
 
@@ -216,6 +228,14 @@ void expectSameMaps(const std::vector<TriangleSetup>& setups, const SampleGrid& 
     ASSERT_EQ(fast.keys, slow.keys) << label;
     ASSERT_EQ(avx2.keys, slow.keys) << label;
     ASSERT_EQ(baseline.keys, slow.keys) << label;
+    for (const Maps* m : {&fast, &avx2, &baseline, &slow}) ASSERT_EQ(m->blockKeys, slow.keys) << label;
+    // Whole covered blocks taken as planes where the kernels have a
+    // whole-block path (AVX2 and up, float formats, no alpha test).
+    if (!alpha && (format == DepthFormat::FloatReversed || format == DepthFormat::Float)) {
+      EXPECT_GT(fast.planeBlocks, 0) << label;
+      EXPECT_GT(avx2.planeBlocks, 0) << label;
+    }
+    EXPECT_EQ(slow.planeBlocks, 0) << label;
     EXPECT_EQ(avx2.counters.samplesTested, fast.counters.samplesTested) << label;
     EXPECT_EQ(avx2.counters.samplesPassed, fast.counters.samplesPassed) << label;
     EXPECT_EQ(baseline.counters.samplesTested, fast.counters.samplesTested) << label;

@@ -7,14 +7,20 @@
 // shadow its analytic mask says, no more and no less.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <random>
+#include <string>
 
 #include "common/analysis.h"
+#include "common/gltf/loader.h"
 #include "common/shading.h"
 #include "raster/rasterizer.h"
 #include "raster/shadow_map.h"
 #include "raster_test_util.h"
+#include "tests/test_labels.h"
 
 namespace rastray {
 namespace {
@@ -77,18 +83,95 @@ TEST(ShadowMapPass, FastMapsEqualTheReferenceWalks) {
     for (size_t i = 0; i < fast.mapCount(); ++i) {
       const ShadowMaps::Map& a = fast.mapAt(i);
       const ShadowMaps::Map& b = slow.mapAt(i);
-      const size_t n = size_t(size) * size_t(size);
-      ASSERT_TRUE(std::equal(a.depth.keys.get(), a.depth.keys.get() + n, b.depth.keys.get())) << "map " << i;
+      for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x)
+          ASSERT_EQ(a.depth.key(x, y), b.depth.key(x, y)) << "map " << i << " texel " << x << " " << y;
       ASSERT_EQ(a.attenuation.size(), b.attenuation.size()) << "map " << i;
-      for (size_t k = 0; k < a.attenuation.size(); ++k) {
-        EXPECT_EQ(a.attenuation[k].texel, b.attenuation[k].texel);
-        EXPECT_EQ(a.attenuation[k].key, b.attenuation[k].key);
-        EXPECT_EQ(a.attenuation[k].transmittance, b.attenuation[k].transmittance);
+      for (size_t tile = 0; tile < a.attenuation.size(); ++tile) {
+        ASSERT_EQ(a.attenuation[tile].size(), b.attenuation[tile].size()) << "map " << i << " tile " << tile;
+        for (size_t k = 0; k < a.attenuation[tile].size(); ++k) {
+          EXPECT_EQ(a.attenuation[tile][k].texel, b.attenuation[tile][k].texel);
+          EXPECT_EQ(a.attenuation[tile][k].key, b.attenuation[tile][k].key);
+          EXPECT_EQ(a.attenuation[tile][k].transmittance, b.attenuation[tile][k].transmittance);
+        }
       }
       EXPECT_EQ(a.attenuationRows, b.attenuationRows) << "map " << i;
     }
   }
 }
+
+// The maps of every lit bundled scene (scenes/*.gltf, scenes/stiff/*.gltf)
+// by 8×8 blocks (planes, keys, clear) against the reference walk's, whose
+// blocks are all keys (the maps as they were stored before blocks): every
+// texel's key, every transmissive fragment, and the transmittance of
+// lookups at every triangle's vertices and centroid, from the fast lookup
+// on the block maps and the reference lookup on the reference maps.
+TEST(ShadowMapPass, BlockMapsLookUpAsTheReferenceMapsOnTheBundledLitScenes) {
+  std::vector<std::string> paths;
+  for (const char* dir : {"", "/stiff"})
+    for (const auto& entry : std::filesystem::directory_iterator(std::string(RASTRAY_SCENES) + dir))
+      if (entry.path().extension() == ".gltf") paths.push_back(entry.path().string());
+  std::sort(paths.begin(), paths.end());
+  size_t lit = 0, planeBlocks = 0, lookups = 0, dark = 0, partial = 0;
+  for (const std::string& path : paths) {
+    const Scene scene = loadScene(path);
+    if (scene.lights.empty()) continue;
+    ++lit;
+    const SceneAnalysis analysis = analyzeScene(scene);
+    const Camera camera = makeCamera(scene, {}, 16, 16);
+    RasterOptions options;
+    options.shadowMapSize = 150;  // partial tiles and blocks at the edges
+    const Shader shader{scene, analysis, camera, options.shading, nullptr, nullptr};
+    const ShadowMaps fast(scene, options, &shader, CoveragePath::Fast);
+    const ShadowMaps slow(scene, options, &shader, CoveragePath::Reference);
+    ASSERT_EQ(fast.mapCount(), slow.mapCount()) << path;
+    for (size_t i = 0; i < fast.mapCount(); ++i) {
+      const ShadowMaps::Map& a = fast.mapAt(i);
+      const ShadowMaps::Map& b = slow.mapAt(i);
+      for (uint32_t o : a.depth.owner) planeBlocks += BlockDepthMap::isPlane(o);
+      for (int y = 0; y < options.shadowMapSize; ++y)
+        for (int x = 0; x < options.shadowMapSize; ++x)
+          ASSERT_EQ(a.depth.key(x, y), b.depth.key(x, y))
+              << path << " map " << i << " texel " << x << " " << y;
+      ASSERT_EQ(a.attenuation.size(), b.attenuation.size()) << path;
+      for (size_t tile = 0; tile < a.attenuation.size(); ++tile) {
+        ASSERT_EQ(a.attenuation[tile].size(), b.attenuation[tile].size()) << path;
+        for (size_t k = 0; k < a.attenuation[tile].size(); ++k) {
+          ASSERT_EQ(a.attenuation[tile][k].texel, b.attenuation[tile][k].texel) << path;
+          ASSERT_EQ(a.attenuation[tile][k].key, b.attenuation[tile][k].key) << path;
+          ASSERT_EQ(a.attenuation[tile][k].transmittance, b.attenuation[tile][k].transmittance) << path;
+        }
+      }
+    }
+    for (uint32_t inst = 0; inst < scene.instances.size(); ++inst)
+      for (uint32_t t = 0; t < scene.instances[inst].triangleCount; ++t)
+        for (const glm::vec2 bary :
+             {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(0, 1), glm::vec2(1.0f / 3)}) {
+          const SurfacePoint p = makeSurfacePoint(scene, SampleHit{inst, t, 0.0f, bary.x, bary.y});
+          for (size_t l = 0; l < scene.lights.size(); ++l) {
+            const Light& light = scene.lights[l];
+            const glm::dvec3 toLight = light.type == LightType::Directional
+                                           ? -light.direction
+                                           : glm::normalize(light.position - p.position);
+            const glm::vec3 f = fast.lightTransmittance(int(l), p.position, p.geometricNormal, toLight);
+            const glm::vec3 r =
+                slow.lightTransmittanceReference(int(l), p.position, p.geometricNormal, toLight);
+            ASSERT_EQ(std::memcmp(&f, &r, sizeof f), 0) << path << " instance " << inst << " triangle " << t;
+            ++lookups;
+            dark += f == glm::vec3(0.0f);
+            partial += f != glm::vec3(0.0f) && f != glm::vec3(1.0f);
+          }
+        }
+  }
+  // Not vacuous: lit scenes, planes, shadows and light through glass.
+  EXPECT_GE(lit, 10u);
+  EXPECT_GT(planeBlocks, 1000u);
+  EXPECT_GT(dark, 100u);
+  EXPECT_GT(partial, 10u);
+  std::printf("%zu lit scenes, %zu plane blocks, %zu lookups (%zu dark, %zu partial)\n", lit, planeBlocks,
+              lookups, dark, partial);
+}
+RASTRAY_TEST_LABELS_OF(ShadowMapPass, BlockMapsLookUpAsTheReferenceMapsOnTheBundledLitScenes, "slow");
 
 // The tiles' fragment sort gives std::stable_sort's order by (texel,
 // key): few fragments and many (the counting pass), every texel of a
