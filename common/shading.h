@@ -71,7 +71,7 @@ class LightVisibility {
   // alone (whatever else is in the batch), asked in order k = 0, 1, ….
   // The shading kernel calls it once per light with the lanes it lights.
   // This default asks one at a time; the ray caster traces the first
-  // occlusion query of up to 16 rays as one packet (rtcOccluded16).
+  // occlusion query of up to 14 rays as one packet (rtcOccluded16).
   virtual void transmittances(int lightIndex, size_t n, const SurfacePoint* const* points,
                               const glm::dvec3* toLight, const double* distance, glm::vec3* out) const;
 };

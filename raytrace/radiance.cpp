@@ -16,6 +16,11 @@ namespace rastray {
 namespace {
 
 // Defined below, each after the function that uses it.
+struct OriginInputs {
+  FloatTriangle triangle;
+  glm::dvec3 side, lift;
+};
+OriginInputs originInputs(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction);
 glm::vec3 secondaryRayOrigin(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction,
                              glm::dvec3* sideOut = nullptr);
 FloatTriangle floatTriangle(const Scene& scene, uint32_t instance, uint32_t triangle);
@@ -129,8 +134,8 @@ glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& con
 
 void traceTransmittances(const CasterState& state, const RayTreeContext& context, size_t n,
                          const SurfacePoint* const* points, const glm::dvec3* toLight, const double* distance,
-                         glm::vec3* out, bool packets) {
-  if (context.recorder || !packets) {
+                         glm::vec3* out, bool packets, const int* lanes) {
+  if (!lanes && (context.recorder || !packets)) {
     for (size_t k = 0; k < n; ++k)
       out[k] = traceTransmittance(state, context, *points[k], toLight[k], distance[k]);
     return;
@@ -141,17 +146,36 @@ void traceTransmittances(const CasterState& state, const RayTreeContext& context
   bool blocked[kShadowPacket];
   for (size_t first = 0; first < n; first += kShadowPacket) {
     const size_t m = std::min(kShadowPacket, n - first);
-    if (m == 1) {  // a packet of one: the single-ray query
-      out[first] = traceTransmittance(state, context, *points[first], toLight[first], distance[first]);
-      break;
-    }
+    // The lanes' origins together (errorBoundRayOrigins: the certification
+    // in double SIMD lanes), then each lane's ray as startShadowRay sets it.
+    FloatTriangle triangles[kShadowPacket];
+    glm::dvec3 positions[kShadowPacket], lifts[kShadowPacket];
+    float b1[kShadowPacket], b2[kShadowPacket];
     for (size_t k = 0; k < m; ++k) {
       context.count(RayKind::Shadow);
+      const SurfacePoint& p = *points[first + k];
       dirs[k] = glm::normalize(toLight[first + k]);
-      origins[k] =
-          startShadowRay(state, *points[first + k], dirs[k], distance[first + k], gathers[k], &sides[k]);
+      const OriginInputs in = originInputs(state, p, dirs[k]);
+      triangles[k] = in.triangle;
+      sides[k] = in.side;
+      lifts[k] = in.lift;
+      positions[k] = p.position;
+      b1[k] = p.b1;
+      b2[k] = p.b2;
     }
-    traceOcclusionPacket(state, gathers, m, blocked);
+    if (state.options.offset == RayOffsetMethod::FloatUlps)
+      for (size_t k = 0; k < m; ++k)
+        origins[k] = floatUlpsRayOrigin(glm::vec3(positions[k] + lifts[k]), glm::vec3(sides[k]));
+    else
+      errorBoundRayOrigins(m, triangles, positions, b1, b2, sides, lifts, origins);
+    for (size_t k = 0; k < m; ++k) {
+      HitGather& g = gathers[k];
+      g.mode = GatherMode::Shadow;
+      g.primary = false;
+      g.ray = secondaryRay(origins[k], dirs[k], distance[first + k]);
+      g.hits.clear();
+    }
+    traceOcclusionPacket(state, gathers, m, blocked, lanes);
     for (size_t k = 0; k < m; ++k)
       out[first + k] = finishTransmittance(state, context, *points[first + k], dirs[k], distance[first + k],
                                            origins[k], sides[k], gathers[k], blocked[k]);
@@ -165,6 +189,16 @@ namespace {
 // included.
 glm::vec3 secondaryRayOrigin(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction,
                              glm::dvec3* sideOut) {
+  const OriginInputs in = originInputs(state, from, direction);
+  if (sideOut) *sideOut = in.side;
+  if (state.options.offset == RayOffsetMethod::FloatUlps)
+    return floatUlpsRayOrigin(glm::vec3(from.position + in.lift), glm::vec3(in.side));
+  return errorBoundRayOrigin(in.triangle, from.position, from.b1, from.b2, in.side, in.lift);
+}
+
+// What the offset of a ray leaving `from` along `direction` starts from:
+// its triangle, the side it leaves on and the terminator lift.
+OriginInputs originInputs(const CasterState& state, const SurfacePoint& from, const glm::dvec3& direction) {
   glm::dvec3 side = offsetSideNormal(from.geometricNormal, direction);
   const Scene& scene = state.scene;
   const glm::uvec3 t = scene.triangle(from.instance, from.triangle);
@@ -189,10 +223,7 @@ glm::vec3 secondaryRayOrigin(const CasterState& state, const SurfacePoint& from,
         side = liftSide;
     }
   }
-  if (sideOut) *sideOut = side;
-  if (state.options.offset == RayOffsetMethod::FloatUlps)
-    return floatUlpsRayOrigin(glm::vec3(from.position + lift), glm::vec3(side));
-  return errorBoundRayOrigin(triangle, from.position, from.b1, from.b2, side, lift);
+  return {triangle, side, lift};
 }
 
 FloatTriangle floatTriangle(const Scene& scene, uint32_t instance, uint32_t triangle) {

@@ -221,6 +221,15 @@ void RayCaster::transmittances(int /*lightIndex*/, size_t n, const SurfacePoint*
                       impl_->options.shadowPackets);
 }
 
+void RayCaster::transmittancesInLanes(size_t n, const SurfacePoint* const* points, const glm::dvec3* toLight,
+                                      const double* distance, const int* lanes, glm::vec3* out) const {
+  RASTRAY_CHECK(impl_->bound, "RayCaster::transmittancesInLanes before bind");
+  RASTRAY_CHECK(n <= kShadowPacket, "one packet holds at most 14 rays, not " + std::to_string(n));
+  for (size_t k = 0; k < n; ++k)
+    RASTRAY_CHECK(lanes[k] >= 0 && lanes[k] < 16, "lane " + std::to_string(lanes[k]));
+  traceTransmittances(*impl_, untracedContext(*impl_), n, points, toLight, distance, out, true, lanes);
+}
+
 void RayCaster::resetCounters() {
   for (ThreadRays& local : impl_->threads) local.counts = RayCounts{};
 }

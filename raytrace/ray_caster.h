@@ -49,8 +49,8 @@
 //   are rejected by a filter on those geometries, for every ray kind.
 // - Cut-off (SPEC §6): when compositing stops with layers left, the last
 //   deep sample of that sample gets DeepSample::cutOff.
-// - Shadow rays (rtcOccluded1) run to the light (distance, or +inf for
-//   directional lights); occlusion filters accept opaque hits (blocked)
+// - Shadow rays (rtcOccluded16, up to 14 to a packet) run to the light
+//   (distance, or +inf for directional lights); occlusion filters accept opaque hits (blocked)
 //   and collect the rest, whose Shader::shadowTransmittance values multiply
 //   (BLEND 1 − α, refractive transmission × C; SPEC §5). A blocked one
 //   asks for its first hit (one rtcIntersect1): when that surface passes
@@ -159,15 +159,12 @@ struct RayOptions {
   bool packets = true;
   bool forcePackets = false;
   // Shadow rays of one light from the shading kernel's lit lanes traced
-  // 16 at a time (rtcOccluded16: LightVisibility::transmittances), in
-  // the ray caster and in hybrid alike. Off by default: Embree's packet and
-  // single-ray tests agree on every shadow ray of the bundled scenes, but
-  // not 1e6 units from the origin (a sloped floor's contact shadow), and
-  // the two renderers group lit lanes differently (a batch of one goes
-  // single), so with packets hybrid and the ray caster differ there
-  // (FarFromOriginOffsets.HybridAgreesWithTheRayCaster fails). false: one
-  // rtcOccluded1 per ray.
-  bool shadowPackets = false;
+  // 14 at a time (rtcOccluded16: LightVisibility::transmittances), in the
+  // ray caster and in hybrid alike. Every occlusion query goes through
+  // rtcOccluded16, a single ray as a packet of one, and a lane's answer
+  // does not depend on its lane or its packet mates, so the pictures are
+  // the same either way (--no-shadow-packets: one ray per packet).
+  bool shadowPackets = true;
   // Rays per packet: 4, 8 or 16 (rtcIntersect4/8/16), each packet a compact
   // block of pixels (Morton order within the tile). 16 measured fastest on
   // this AVX-512 machine (the engine model, 1920×1080, 1 thread: primary
@@ -237,6 +234,11 @@ class RayCaster : public SecondaryRayTracer, public LightVisibility {
                           double distance) const override;
   void transmittances(int lightIndex, size_t n, const SurfacePoint* const* points, const glm::dvec3* toLight,
                       const double* distance, glm::vec3* out) const override;
+  // transmittances() of n ≤ 14 rays in one packet, ray k in lane lanes[k]
+  // (distinct, 0…15), the other lanes empty: for the test that a lane's
+  // answer depends neither on its lane nor on its packet mates.
+  void transmittancesInLanes(size_t n, const SurfacePoint* const* points, const glm::dvec3* toLight,
+                             const double* distance, const int* lanes, glm::vec3* out) const;
 
   // Rays traced since the last bind(), render() or resetCounters(), by
   // kind (SPEC §8: zero for what the scene does not need). render()'s

@@ -50,8 +50,16 @@ namespace rastray {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// Rays per shadow-ray packet (rtcOccluded16).
-constexpr size_t kShadowPacket = 16;
+// Rays per shadow-ray packet: at most 14 of an RTCRay16's 16 lanes. Embree
+// 3.13.5's packet traversal (BVHNIntersectorKHybrid::occluded, incoherent
+// context) goes on as a packet only while more than 14 of 16 lanes are
+// active (switchThresholdIncoherent) and otherwise traverses each active
+// lane alone with the single-ray box and triangle tests; there a lane's
+// answer is its own, whatever its lane and its mates. Packet-mode leaf
+// tests round differently: 16 lanes would let a lane's mates decide a ray
+// that starts on a neighbour's plane (tested:
+// ShadowPackets.ALanesAnswerDependsNeitherOnItsLaneNorOnItsMates).
+constexpr size_t kShadowPacket = 14;
 
 // Rays traced, by RayKind.
 using RayCounts = std::array<uint64_t, kRayKindCount>;
@@ -293,15 +301,17 @@ GatheredHit intersectClosest(const CasterState& state, HitGather& g, bool cohere
 // One occlusion traversal of g.ray (g.mode Shadow): true when an opaque
 // surface blocks it; otherwise g.hits holds the surfaces it passes
 // through, one hit per crossing, ordered by (traversal t, instance,
-// triangle).
+// triangle). A packet of one (traceOcclusionPacket): every occlusion query
+// takes the same Embree path.
 bool traceOcclusion(const CasterState& state, HitGather& g);
 
 // traceOcclusion for n ≤ kShadowPacket rays at once, gathers[k].ray the
-// kth (its ray id k), as one rtcOccluded16 packet: blocked[k] and
-// gathers[k].hits as traceOcclusion(state, gathers[k]) leaves them (the
-// tests demand it on every shadow ray of the bundled scenes: Embree's
-// packet and single-ray triangle tests are separate code).
-void traceOcclusionPacket(const CasterState& state, HitGather* gathers, size_t n, bool* blocked);
+// kth (its ray id k) in lane lanes[k] (nullptr: lane k) of one
+// rtcOccluded16 packet, the other lanes empty: blocked[k] and
+// gathers[k].hits as traceOcclusion(state, gathers[k]) leaves them, bit
+// for bit (kShadowPacket says why).
+void traceOcclusionPacket(const CasterState& state, HitGather* gathers, size_t n, bool* blocked,
+                          const int* lanes = nullptr);
 
 // The surfaces along a traced ray, front to back: the gathered BLEND hits
 // in front of `closest` (the stopping hit, or none), one per crossing, then
@@ -342,11 +352,13 @@ glm::vec3 traceTransmittance(const CasterState& state, const RayTreeContext& con
 // LightVisibility::transmittances: traceTransmittance of each point, the
 // first occlusion query of up to kShadowPacket of them in one packet
 // (traceOcclusionPacket), the rest of each (a seam's retries) as
-// traceTransmittance continues. A recorded tree (context.recorder) or
-// `packets` false traces them one by one.
+// traceTransmittance continues: the same result bits as one by one. A
+// recorded tree (context.recorder) or `packets` false traces them one by
+// one; `lanes` (n ≤ kShadowPacket, RayCaster::transmittancesInLanes) puts
+// ray k in lane lanes[k] of one packet.
 void traceTransmittances(const CasterState& state, const RayTreeContext& context, size_t n,
                          const SurfacePoint* const* points, const glm::dvec3* toLight, const double* distance,
-                         glm::vec3* out, bool packets = true);
+                         glm::vec3* out, bool packets = true, const int* lanes = nullptr);
 
 // --- primary visibility (primary_visibility.cpp) ------------------------------
 

@@ -5,20 +5,16 @@
 #include <cstring>
 #include <limits>
 
+#include "raytrace/ray_offset_lanes.h"
+
 namespace rastray {
 
 namespace {
 
-constexpr double kU = 0x1p-24;   // float unit roundoff: Embree's arithmetic
+using detail::kEvalSlack;
+using detail::kU;  // float unit roundoff: Embree's arithmetic
+using detail::kUnderflow;
 constexpr double kUd = 0x1p-53;  // double unit roundoff: ours
-// Evaluating the bounds in double: inputs are floats (their differences
-// exact, or off by 2⁻⁵³), each product and sum rounds a few times more, so
-// 2⁻⁴⁵ of the magnitudes involved covers it (against Embree's 2⁻²⁴).
-constexpr double kEvalSlack = 0x1p-45;
-// Results flushed to zero under FTZ lose less than FLT_MIN = 2⁻¹²⁶ each;
-// a handful of them, scaled by at most the magnitudes R and C, stay below
-// this times (1 + ΣR + ΣC).
-constexpr double kUnderflow = 0x1p-118;
 // The least height: t = T·rcp(den) ≈ −height/cos must stay a normal
 // float, since FTZ would make it −0 and tnear 0 ≤ −0 holds.
 constexpr double kMinHeight = 0x1p-120;
@@ -248,14 +244,35 @@ bool liftedRayCrossesItsTriangle(const FloatTriangle& triangle, const glm::dvec3
   return u >= -kMargin && v >= -kMargin && 1.0 - u - v >= -kMargin;
 }
 
-glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
-                              const glm::dvec3& side, const glm::dvec3& lift) {
+namespace {
+
+// errorBoundRayOrigin in three parts, so a batch (errorBoundRayOrigins)
+// can take the two margins between them in SIMD lanes.
+struct OriginJob {
+  Vertices p;  // as Embree reads them
+  double normalLength = 0.0;
+  double s = 1.0;  // sideSign(p, side)
+  glm::dvec3 side{0.0}, lifted{0.0};
+  double dPos = 0.0;
+  bool degenerate = false;  // no plane to leave: `fallback` is the origin
+  glm::vec3 fallback{0.0f};
+};
+
+// Step 1 (header), and what step 2 needs.
+OriginJob startOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
+                      const glm::dvec3& side, const glm::dvec3& lift) {
+  OriginJob j;
   const TriangleMemo& data = triangleData(triangle);
-  const Vertices& p = data.p;
-  const double normalLength = data.normalLength;
-  if (!(normalLength > 0.0) || !std::isfinite(normalLength))
-    return floatUlpsRayOrigin(glm::vec3(position + lift), glm::vec3(side));  // no plane to leave
-  const double s = glm::dot(side, data.normal) >= 0.0 ? 1.0 : -1.0;          // sideSign(p, side)
+  j.p = data.p;
+  j.normalLength = data.normalLength;
+  j.side = side;
+  j.lifted = position + lift;
+  if (!(j.normalLength > 0.0) || !std::isfinite(j.normalLength)) {
+    j.degenerate = true;
+    j.fallback = floatUlpsRayOrigin(glm::vec3(position + lift), glm::vec3(side));  // no plane to leave
+    return j;
+  }
+  j.s = glm::dot(side, data.normal) >= 0.0 ? 1.0 : -1.0;  // sideSign(p, side)
 
   // 1. How far the double hit point may lie off the plane (header).
   const double b0 = 1.0 - double(b1) - double(b2);
@@ -265,15 +282,20 @@ glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& p
     pError[k] = gammaD(3) * (std::abs(b0 * triangle[0][k]) + std::abs(double(b1) * triangle[1][k]) +
                              std::abs(double(b2) * triangle[2][k])) +
                 weightError * std::abs(double(triangle[0][k]));
-  const double dPos = glm::dot(glm::abs(side), pError);
+  j.dPos = glm::dot(glm::abs(side), pError);
+  return j;
+}
 
+// Step 3's rounding, from `estimate`, margin(p, lifted, s, normalLength)'s
+// bound: the float origin before its check; *axis the compensating axis.
+glm::vec3 roundOrigin(const OriginJob& j, double estimate, int* axis) {
   // 2. Embree's bound, estimated at the hit point, as a height.
-  const glm::dvec3 lifted = position + lift;
-  const double dEmbree = std::max(margin(p, lifted, s, normalLength).bound / normalLength, kMinHeight);
+  const double dEmbree = std::max(estimate / j.normalLength, kMinHeight);
 
   // 3. Round, then check the float origin and move axis m outward until
   // it passes: the estimate above is only the starting point.
-  const glm::dvec3 q = lifted + (dPos + dEmbree) * side;
+  const glm::dvec3& side = j.side;
+  const glm::dvec3 q = j.lifted + (j.dPos + dEmbree) * side;
   const int m = compensatingAxis(q, side);
   // The others to nearest; whatever height their rounding gained or lost
   // (Σ (o_k − q_k)·n_k), axis m gives back or takes, then rounds outward.
@@ -285,9 +307,17 @@ glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& p
     qm -= (double(o[k]) - q[k]) * side[k] / side[m];
   }
   o[m] = roundOutward(qm, side[m]);
+  *axis = m;
+  return o;
+}
+
+// Step 3's check: moves axis m of `o` outward until it passes. `first`:
+// margin(p, dazd(o), s, normalLength) when the caller has it.
+glm::vec3 certifyOrigin(const OriginJob& j, glm::vec3 o, int m, const EmbreeSideMargin* first) {
+  const glm::dvec3& side = j.side;
   double growth = 1.0;
   for (int i = 0; i < 64; ++i) {
-    const EmbreeSideMargin c = margin(p, dazd(o), s, normalLength);
+    const EmbreeSideMargin c = i == 0 && first ? *first : margin(j.p, dazd(o), j.s, j.normalLength);
     if (certified(c)) break;
     // The height still missing, along axis m (G grows by |N_m| per unit).
     const double deficit = std::max(c.bound - c.volume, kMinHeight * c.normalLength - c.volume);
@@ -304,6 +334,65 @@ glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& p
     if (i >= 4) growth *= 2.0;
   }
   return o;
+}
+
+}  // namespace
+
+glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
+                              const glm::dvec3& side, const glm::dvec3& lift) {
+  const OriginJob j = startOrigin(triangle, position, b1, b2, side, lift);
+  if (j.degenerate) return j.fallback;
+  int m = 0;
+  const glm::vec3 o = roundOrigin(j, margin(j.p, j.lifted, j.s, j.normalLength).bound, &m);
+  return certifyOrigin(j, o, m, nullptr);
+}
+
+void errorBoundRayOrigins(size_t n, const FloatTriangle* triangles, const glm::dvec3* positions,
+                          const float* b1, const float* b2, const glm::dvec3* sides, const glm::dvec3* lifts,
+                          glm::vec3* out) {
+  constexpr size_t kBatch = detail::kOriginLanes;
+  OriginJob jobs[kBatch];
+  alignas(64) double soa[12][kBatch];  // p0 p1 p2 (x, y, z each), then the origin
+  alignas(64) double det[kBatch], bound[kBatch];
+  int axis[kBatch];
+  for (size_t first = 0; first < n; first += kBatch) {
+    const size_t m = std::min(kBatch, n - first);
+    for (size_t k = 0; k < kBatch; ++k) {
+      if (k < m) {
+        jobs[k] = startOrigin(triangles[first + k], positions[first + k], b1[first + k], b2[first + k],
+                              sides[first + k], lifts[first + k]);
+      } else {
+        jobs[k] = OriginJob{};  // padding: a zero triangle, computed and ignored
+        jobs[k].degenerate = true;
+      }
+      for (int i = 0; i < 3; ++i)
+        for (int c = 0; c < 3; ++c) soa[3 * i + c][k] = jobs[k].p[size_t(i)][c];
+      for (int c = 0; c < 3; ++c) soa[9 + c][k] = jobs[k].lifted[c];
+    }
+    // 2. The estimate at the lifted point, in lanes.
+    detail::embreeMarginLanes(soa, det, bound);
+    for (size_t k = 0; k < m; ++k) {
+      if (jobs[k].degenerate) continue;
+      const glm::vec3 o = roundOrigin(jobs[k], bound[k], &axis[k]);
+      out[first + k] = o;
+      const glm::dvec3 od = dazd(o);
+      for (int c = 0; c < 3; ++c) soa[9 + c][k] = od[c];
+    }
+    // 3. The first check of each rounded origin, in lanes.
+    detail::embreeMarginLanes(soa, det, bound);
+    for (size_t k = 0; k < m; ++k) {
+      const OriginJob& j = jobs[k];
+      if (j.degenerate) {
+        out[first + k] = j.fallback;
+        continue;
+      }
+      EmbreeSideMargin c;
+      c.volume = -j.s * det[k];
+      c.bound = bound[k];
+      c.normalLength = j.normalLength;
+      out[first + k] = certifyOrigin(j, out[first + k], axis[k], &c);
+    }
+  }
 }
 
 double seamTolerance(const FloatTriangle& own, const glm::dvec3& position, const glm::vec3& o) {

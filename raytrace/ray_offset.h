@@ -92,6 +92,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <glm/glm.hpp>
@@ -110,6 +111,16 @@ using FloatTriangle = std::array<glm::vec3, 3>;
 // position + lift, as without it.
 glm::vec3 errorBoundRayOrigin(const FloatTriangle& triangle, const glm::dvec3& position, float b1, float b2,
                               const glm::dvec3& side, const glm::dvec3& lift = glm::dvec3(0.0));
+
+// errorBoundRayOrigin for n rays: out[k] = errorBoundRayOrigin(triangles[k],
+// positions[k], b1[k], b2[k], sides[k], lifts[k]), bit for bit. The two
+// Embree margins each origin needs (the estimate at the hit point, the
+// check of the rounded origin) run 16 rays at a time in double SIMD lanes
+// (ray_offset_lanes.h, every Highway target alike); an origin the check
+// moves further continues alone.
+void errorBoundRayOrigins(size_t n, const FloatTriangle* triangles, const glm::dvec3* positions,
+                          const float* b1, const float* b2, const glm::dvec3* sides, const glm::dvec3* lifts,
+                          glm::vec3* out);
 
 // The unit vertex normals of one triangle, in stored order.
 using VertexNormals = std::array<glm::vec3, 3>;

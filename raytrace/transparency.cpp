@@ -5,6 +5,7 @@
 // front-to-back surface list, which the integrator composites.
 #include <algorithm>
 #include <array>
+#include <string>
 #include <utility>
 
 #include "raytrace/ray_caster_parts.h"
@@ -123,53 +124,59 @@ GatheredHit intersectClosest(const CasterState& state, HitGather& g, bool cohere
 }
 
 bool traceOcclusion(const CasterState& state, HitGather& g) {
-  RTCRayHit rh = makeRayHit(glm::vec3(g.ray.origin), glm::vec3(g.ray.direction), float(g.ray.tNear),
-                            float(g.ray.tFar), 0);
-  GatherContext context;
-  rtcInitIntersectContext(&context.embree);
-  context.gathers = &g;
-  {
-    FlushDenormalsScope ftz;
-    rtcOccluded1(state.embree->handle(), &context.embree, &rh.ray);
-  }
-  if (rh.ray.tfar == -kInf) return true;  // Embree's mark of an accepted (blocking) hit
-  if (!g.hits.empty()) sortAndMergeCrossings(state.scene, g.ray, &g.hits);
-  return false;
+  bool blocked = false;
+  traceOcclusionPacket(state, &g, 1, &blocked);
+  return blocked;
 }
 
-void traceOcclusionPacket(const CasterState& state, HitGather* gathers, size_t n, bool* blocked) {
-  static_assert(kShadowPacket == 16, "one RTCRay16 per packet");
+void traceOcclusionPacket(const CasterState& state, HitGather* gathers, size_t n, bool* blocked,
+                          const int* lanes) {
+  static_assert(kShadowPacket <= 14, "Embree traverses a packet of 16 lane by lane only up to 14 lanes");
+  RASTRAY_CHECK(n <= kShadowPacket, "a shadow packet of " + std::to_string(n) + " rays");
   alignas(64) int valid[16];
   alignas(64) RTCRay16 ray;
-  for (size_t i = 0; i < 16; ++i) {
+  int laneOf[kShadowPacket];
+  for (size_t i = 0; i < n; ++i) laneOf[i] = lanes ? lanes[i] : int(i);
+  for (size_t l = 0; l < 16; ++l) {
     // Lanes without a ray: invalid, and a harmless ray should Embree read them.
-    const bool used = i < n;
-    // traceOcclusion's float ray (makeRayHit's fields), lane by lane.
-    const glm::vec3 o = used ? glm::vec3(gathers[i].ray.origin) : glm::vec3(0.0f);
-    const glm::vec3 d = used ? glm::vec3(gathers[i].ray.direction) : glm::vec3(0.0f, 0.0f, -1.0f);
-    valid[i] = used ? -1 : 0;
-    ray.org_x[i] = o.x;
-    ray.org_y[i] = o.y;
-    ray.org_z[i] = o.z;
-    ray.tnear[i] = used ? float(gathers[i].ray.tNear) : 0.0f;
-    ray.dir_x[i] = d.x;
-    ray.dir_y[i] = d.y;
-    ray.dir_z[i] = d.z;
-    ray.time[i] = 0.0f;
-    ray.tfar[i] = used ? float(gathers[i].ray.tFar) : -kInf;
-    ray.mask[i] = 0xFFFFFFFFu;
-    ray.id[i] = unsigned(i);
-    ray.flags[i] = 0;
+    valid[l] = 0;
+    ray.org_x[l] = ray.org_y[l] = ray.org_z[l] = 0.0f;
+    ray.tnear[l] = 0.0f;
+    ray.dir_x[l] = ray.dir_y[l] = 0.0f;
+    ray.dir_z[l] = -1.0f;
+    ray.time[l] = 0.0f;
+    ray.tfar[l] = -kInf;
+    ray.mask[l] = 0xFFFFFFFFu;
+    ray.id[l] = 0;
+    ray.flags[l] = 0;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    // The float ray of makeRayHit's fields, in its lane; its id indexes gathers.
+    const size_t l = size_t(laneOf[i]);
+    const glm::vec3 o(gathers[i].ray.origin), d(gathers[i].ray.direction);
+    valid[l] = -1;
+    ray.org_x[l] = o.x;
+    ray.org_y[l] = o.y;
+    ray.org_z[l] = o.z;
+    ray.tnear[l] = float(gathers[i].ray.tNear);
+    ray.dir_x[l] = d.x;
+    ray.dir_y[l] = d.y;
+    ray.dir_z[l] = d.z;
+    ray.tfar[l] = float(gathers[i].ray.tFar);
+    ray.id[l] = unsigned(i);
   }
   GatherContext context;
   rtcInitIntersectContext(&context.embree);
+  // Incoherent (the default flag): with the coherent flag Embree traverses
+  // the packet as a frustum and lanes test leaves their own boxes missed,
+  // which changes a lane's answer with its mates.
   context.gathers = gathers;
   {
     FlushDenormalsScope ftz;
     rtcOccluded16(valid, state.embree->handle(), &context.embree, &ray);
   }
   for (size_t i = 0; i < n; ++i) {
-    blocked[i] = ray.tfar[i] == -kInf;
+    blocked[i] = ray.tfar[laneOf[i]] == -kInf;
     if (!blocked[i] && !gathers[i].hits.empty())
       sortAndMergeCrossings(state.scene, gathers[i].ray, &gathers[i].hits);
   }

@@ -352,6 +352,9 @@ const std::vector<RenderOptionSpec> kRenderOptions = {
     {"--no-packets", kRaytrace, OptionCondition::Always,
      "Trace primary rays one by one instead of in coherent packets", 0, "",
      RASTRAY_PARSE((void)v; s.ray.packets = false), RASTRAY_NO_VALUE},
+    {"--no-shadow-packets", kTraced, OptionCondition::Always,
+     "Trace shadow rays one to a packet instead of a kernel block's lit lanes 14 at a time (same pictures)",
+     0, "", RASTRAY_PARSE((void)v; s.ray.shadowPackets = false), RASTRAY_NO_VALUE},
 };
 
 #undef RASTRAY_PARSE

@@ -79,6 +79,7 @@ const std::vector<Expected> kExpected = {
     {"--ray-offset", kRaytrace | kHybrid, OptionCondition::Always, {"float-ulps"}},
     {"--terminator", kRaytrace | kHybrid, OptionCondition::Always, {"none"}},
     {"--no-packets", kRaytrace, OptionCondition::Always, {}},
+    {"--no-shadow-packets", kRaytrace | kHybrid, OptionCondition::Always, {}},
 };
 
 const Expected& expected(const std::string& name) {

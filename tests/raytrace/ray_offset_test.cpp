@@ -12,9 +12,13 @@
 #include <random>
 #include <vector>
 
+#include <hwy/highway.h>
+#include <hwy/targets.h>
+
 #include "common/surface.h"
 #include "raytrace/ray_caster.h"
 #include "raytrace/ray_offset.h"
+#include "raytrace/ray_offset_lanes.h"
 #include "test_scenes.h"
 
 #include "tests/test_labels.h"
@@ -356,6 +360,120 @@ TEST(ErrorBoundOffset, EmbreeDoesNotHitASlopedFloorAgain) {
   EXPECT_GT(certifiedRays, rays * 99 / 100);
   std::printf("sloped floors: %d rays, %d certified; float-ulps rays that hit their floor again: %d\n", rays,
               certifiedRays, floatUlpsHits);
+}
+
+}  // namespace
+}  // namespace rastray
+
+namespace rastray {
+namespace {
+
+// errorBoundRayOrigins (the Embree margins in double SIMD lanes) gives
+// errorBoundRayOrigin's bits for every ray, on every Highway target
+// compiled and supported: triangles of every size and shape, at the
+// origin and 1e6 from it, slivers and degenerate ones, points inside and
+// on their edges, both sides, with and without a lift, in batches of 1 to
+// 40 that mix triangles.
+TEST(ErrorBoundOffset, OriginsInLanesAreTheScalarOrigins) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  struct Ray {
+    FloatTriangle triangle;
+    glm::dvec3 position, side, lift;
+    float b1, b2;
+  };
+  std::vector<Ray> rays;
+  const double offsets[] = {0.0, 1e3, 1e6};
+  const double sizes[] = {1e-3, 1.0, 20.0, 1e4};
+  for (int i = 0; i < 4000; ++i) {
+    const double size = sizes[i % 4], offset = offsets[(i / 4) % 3];
+    const glm::dvec3 base = offset * glm::dvec3(1.0, (i / 12) % 2 ? 1.0 : 0.0, 1.0);
+    FloatTriangle t;
+    for (int v = 0; v < 3; ++v)
+      t[size_t(v)] = glm::vec3(base + size * glm::dvec3(uniform(rng), 0.2 * uniform(rng), uniform(rng)));
+    if (i % 50 == 0) t[2] = t[1] + (t[1] - t[0]) * 1e-6f;  // a sliver
+    if (i % 97 == 0) t[2] = t[1];                          // degenerate
+    const float b1 = i % 7 == 0 ? 0.0f : float(0.5 * (uniform(rng) + 1.0));
+    const float b2 = i % 11 == 0 ? 1.0f - b1 : float(0.5 * (1.0 - b1) * (uniform(rng) + 1.0));
+    const glm::dvec3 p0(t[0]), p1(t[1]), p2(t[2]);
+    const glm::dvec3 position = (1.0 - double(b1) - double(b2)) * p0 + double(b1) * p1 + double(b2) * p2;
+    glm::dvec3 n = glm::cross(p1 - p0, p2 - p0);
+    n = glm::length(n) > 0.0 ? glm::normalize(n) : glm::dvec3(0.0, 1.0, 0.0);
+    const glm::dvec3 side = i % 2 ? n : -n;
+    const glm::dvec3 lift = i % 5 == 0 ? 1e-3 * size * side : glm::dvec3(0.0);
+    rays.push_back({t, position, side, lift, b1, b2});
+  }
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  ASSERT_GE(targets.size(), 1u);
+  for (int64_t target : targets) {
+    SCOPED_TRACE(hwy::TargetName(target));
+    hwy::SetSupportedTargetsForTest(target);
+    for (size_t first = 0; first < rays.size();) {
+      const size_t n = std::min<size_t>(rays.size() - first, 1 + rng() % 40);
+      std::vector<FloatTriangle> triangles;
+      std::vector<glm::dvec3> positions, sides, lifts;
+      std::vector<float> b1, b2;
+      for (size_t k = first; k < first + n; ++k) {
+        triangles.push_back(rays[k].triangle);
+        positions.push_back(rays[k].position);
+        sides.push_back(rays[k].side);
+        lifts.push_back(rays[k].lift);
+        b1.push_back(rays[k].b1);
+        b2.push_back(rays[k].b2);
+      }
+      std::vector<glm::vec3> lanes(n);
+      errorBoundRayOrigins(n, triangles.data(), positions.data(), b1.data(), b2.data(), sides.data(),
+                           lifts.data(), lanes.data());
+      for (size_t k = 0; k < n; ++k) {
+        const Ray& r = rays[first + k];
+        const glm::vec3 scalar = errorBoundRayOrigin(r.triangle, r.position, r.b1, r.b2, r.side, r.lift);
+        ASSERT_EQ(std::memcmp(&scalar, &lanes[k], sizeof scalar), 0)
+            << "ray " << first + k << ": lanes (" << lanes[k].x << ", " << lanes[k].y << ", " << lanes[k].z
+            << ") scalar (" << scalar.x << ", " << scalar.y << ", " << scalar.z << ")";
+      }
+      first += n;
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
+// The lanes' margins themselves (origins rarely show a last-bit change of
+// a bound): embreeMarginLanes against embreeSideMargin, bit for bit, on
+// every target, for float origins around triangles of every size, near
+// and 1e6 from the world origin.
+TEST(ErrorBoundOffset, MarginsInLanesAreTheScalarMargins) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  constexpr size_t kLanes = detail::kOriginLanes;
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    SCOPED_TRACE(hwy::TargetName(target));
+    hwy::SetSupportedTargetsForTest(target);
+    for (int batch = 0; batch < 200; ++batch) {
+      alignas(64) double soa[12][kLanes], det[kLanes], bound[kLanes];
+      FloatTriangle t[kLanes];
+      glm::vec3 o[kLanes];
+      for (size_t k = 0; k < kLanes; ++k) {
+        const double size = std::pow(10.0, -3 + (batch + int(k)) % 8), offset = batch % 3 == 0 ? 1e6 : 0.0;
+        for (int v = 0; v < 3; ++v)
+          t[k][size_t(v)] =
+              glm::vec3(glm::dvec3(offset) + size * glm::dvec3(uniform(rng), uniform(rng), uniform(rng)));
+        o[k] = glm::vec3(glm::dvec3(offset) + size * glm::dvec3(uniform(rng), uniform(rng), uniform(rng)));
+        for (int v = 0; v < 3; ++v)
+          for (int c = 0; c < 3; ++c) soa[3 * v + c][k] = double(t[k][size_t(v)][c]);
+        for (int c = 0; c < 3; ++c) soa[9 + c][k] = double(o[k][c]);
+      }
+      detail::embreeMarginLanes(soa, det, bound);
+      for (size_t k = 0; k < kLanes; ++k) {
+        const glm::dvec3 p0(t[k][0]);
+        const glm::dvec3 n = glm::cross(glm::dvec3(t[k][1]) - p0, glm::dvec3(t[k][2]) - p0);
+        const EmbreeSideMargin m = embreeSideMargin(t[k], o[k], n);  // side +1: volume = −det
+        const double volume = -det[k];
+        ASSERT_EQ(std::memcmp(&m.bound, &bound[k], sizeof(double)), 0) << batch << " " << k;
+        ASSERT_EQ(std::memcmp(&m.volume, &volume, sizeof(double)), 0) << batch << " " << k;
+      }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
 }
 
 }  // namespace

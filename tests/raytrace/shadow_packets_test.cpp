@@ -1,11 +1,10 @@
-// Shadow rays in packets (RayOptions::shadowPackets,
-// LightVisibility::transmittances): the first occlusion query of up to 16
-// rays goes to Embree as one rtcOccluded16. Embree's packet and
-// single-ray triangle and box tests are separate code, and hybrid shares
-// this path with the ray caster (crossval's `hybrid d` must stay 0), so
-// every packet lane must decide exactly what rtcOccluded1 decides. They do
-// on the bundled scenes, not 1e6 units from the origin: packets are off by
-// default.
+// Shadow rays in packets (RayOptions::shadowPackets, on by default;
+// LightVisibility::transmittances): the first occlusion query of up to 14
+// rays goes to Embree as one rtcOccluded16, and a single ray as a packet
+// of one. Hybrid shares this path with the ray caster but batches lit
+// lanes differently (crossval's `hybrid d` must stay 0), so a lane's
+// answer must not depend on its packet mates or its lane, and a batch must
+// decide every ray as one by one does.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -75,12 +74,12 @@ struct Tally {
 };
 
 // Each light's shadow rays from `points`: alone, in one batch (packets of
-// 16 in order) and in a shuffled batch (other packet mates).
+// 14 in order) and in a shuffled batch (other packet mates).
 void expectPacketsAgree(const std::string& name, const Scene& scene, const std::vector<SurfacePoint>& points,
                         Tally* tally) {
   RayCaster caster(scene, analyzeScene(scene));
   RayOptions options;
-  options.shadowPackets = true;  // off by default (RayOptions::shadowPackets says why)
+  options.shadowPackets = true;
   caster.bind(makeCamera(scene, {}, 16, 16), options);
   std::mt19937 rng(7);
   for (size_t l = 0; l < scene.lights.size(); ++l) {
@@ -168,8 +167,7 @@ TEST(ShadowPackets, RayCastFramesWithShadowPacketsAreTheSingleRaysFrames) {
     ++scenes;
     const Camera camera = makeCamera(scene, {}, 48, 36);
     RayOptions options;
-    options.spp = 2;
-    options.shadowPackets = true;
+    options.spp = 2;  // shadowPackets: on by default
     RayCaster caster(scene, analyzeScene(scene));
     caster.bind(camera, options);
     const RenderOutput packets = caster.render();
@@ -184,6 +182,190 @@ TEST(ShadowPackets, RayCastFramesWithShadowPacketsAreTheSingleRaysFrames) {
     EXPECT_EQ(packets.counters.get("rays.shadow"), single.counters.get("rays.shadow")) << path;
   }
   EXPECT_GE(scenes, 5u);
+}
+
+// FarFromOriginOffsets' contact scene, where packet and single-ray
+// occlusion were found to disagree: a floor sloped 1:5, 1e6 units from the
+// origin in x and z, and a 2×1×2 box floating 0.01 above it (a prism
+// sheared along the slope), lit from (−0.6, 1, −0.4). The points: a grid
+// on the floor around and under the box, where shadow rays pass through
+// the gap.
+struct ContactScene {
+  Scene scene;
+  std::vector<SurfacePoint> points;
+};
+
+ContactScene contactSceneAt1e6() {
+  constexpr double kFar = 1e6, kSlope = 0.2, kGap = 0.01;
+  const auto floorY = [&](double z) { return kSlope * (z - kFar); };
+  test::SceneBuilder b;
+  const uint32_t grey = b.addMaterial(test::SceneBuilder::lambert(glm::vec4(0.5f, 0.5f, 0.5f, 1.0f)));
+  std::vector<glm::vec3> floor;
+  for (const glm::dvec2 c :
+       {glm::dvec2(-10, 10), glm::dvec2(10, 10), glm::dvec2(10, -10), glm::dvec2(-10, -10)})
+    floor.emplace_back(glm::dvec3(kFar + c.x, floorY(kFar + c.y), kFar + c.y));
+  const uint32_t floorInstance =
+      b.addMesh(floor, {{0, 1, 2}, {0, 2, 3}}, grey);  // counter-clockwise from above
+  std::vector<glm::vec3> box;                          // corner i: x = bit 0, y = bit 1, z = bit 2
+  for (int i = 0; i < 8; ++i) {
+    const double x = kFar + (i & 1 ? 1.0 : -1.0), z = kFar + (i & 4 ? 1.0 : -1.0);
+    box.emplace_back(glm::dvec3(x, floorY(z) + kGap + (i & 2 ? 1.0 : 0.0), z));
+  }
+  const uint32_t boxInstance = b.addMesh(box,
+                                         {{0, 2, 3},
+                                          {0, 3, 1},
+                                          {4, 5, 7},
+                                          {4, 7, 6},
+                                          {0, 1, 5},
+                                          {0, 5, 4},
+                                          {2, 6, 7},
+                                          {2, 7, 3},
+                                          {0, 4, 6},
+                                          {0, 6, 2},
+                                          {1, 3, 7},
+                                          {1, 7, 5}},
+                                         grey);
+  b.addDirectionalLight(glm::dvec3(0.6, -1.0, 0.4), 3.0f);
+  ContactScene cs{b.scene(), {}};
+  cs.scene.path = "contact scene at 1e6";
+  // Floor point (u, v): f0 + u·(f1 − f0) + v·(f3 − f0); triangle (0, 1, 2)
+  // holds u ≥ v with barycentrics (u − v, v), triangle (0, 2, 3) the rest
+  // with (u, v − u).
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const float u = 0.42f + 0.16f * float(i) / 39.0f, v = 0.42f + 0.16f * float(j) / 39.0f;
+      const bool first = u >= v;
+      const SampleHit h =
+          first ? SampleHit{floorInstance, 0, 0.0f, u - v, v} : SampleHit{floorInstance, 1, 0.0f, u, v - u};
+      cs.points.push_back(makeSurfacePoint(cs.scene, h));
+    }
+  // And on every face of the box, edges included (rays from its top edges
+  // start in the planes of its sides).
+  for (uint32_t t = 0; t < 12; ++t)
+    for (int i = 0; i <= 10; ++i)
+      for (int j = 0; i + j <= 10; ++j)
+        cs.points.push_back(makeSurfacePoint(cs.scene, SampleHit{boxInstance, t, 0.0f, 0.1f * i, 0.1f * j}));
+  return cs;
+}
+
+// Shadow rays that graze, 16 neighbouring points at a time sharing one
+// direction (a coherent packet): a random tangent of the first point's
+// surface tilted towards its normal's side by 1e-6 … 0.3 rad (or away from
+// it, into neighbours), to infinity or a random distance; and for a
+// directional light, each point towards it.
+struct ShadowRays {
+  std::vector<const SurfacePoint*> points;
+  std::vector<glm::dvec3> toLight;
+  std::vector<double> distance;
+};
+
+ShadowRays grazingRays(const Scene& scene, const std::vector<SurfacePoint>& points, std::mt19937& rng) {
+  ShadowRays rays;
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double tilts[] = {1e-6, 1e-4, 1e-3, 1e-2, 0.1, 0.3, -1e-4};
+  glm::dvec3 dir(0.0);
+  double distance = 0.0;
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (k % 16 == 0) {
+      const glm::dvec3 n = points[k].geometricNormal;
+      const glm::dvec3 a = std::abs(n.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+      const glm::dvec3 t1 = glm::normalize(glm::cross(n, a)), t2 = glm::cross(n, t1);
+      const double phi = 6.283185307179586 * uniform(rng);
+      const double tilt = tilts[size_t(uniform(rng) * 7.0) % 7];
+      dir = glm::normalize(std::cos(tilt) * (std::cos(phi) * t1 + std::sin(phi) * t2) + std::sin(tilt) * n);
+      distance = uniform(rng) < 0.5 ? std::numeric_limits<double>::infinity() : 0.1 + 30.0 * uniform(rng);
+    }
+    rays.points.push_back(&points[k]);
+    rays.toLight.push_back(dir);
+    rays.distance.push_back(distance);
+  }
+  if (!scene.lights.empty() && scene.lights[0].type == LightType::Directional)
+    for (const SurfacePoint& p : points) {
+      rays.points.push_back(&p);
+      rays.toLight.push_back(-scene.lights[0].direction);
+      rays.distance.push_back(std::numeric_limits<double>::infinity());
+    }
+  return rays;
+}
+
+// Every shadow ray's transmittance traced alone in lane 0 (what
+// LightVisibility::transmittance does), alone in another lane, in
+// coherent packets (neighbouring points, 14 to a packet, lanes permuted)
+// and among random mates in random lanes: the same bits each time. Far
+// from the origin, grazing, and from box edges lying in the planes of
+// the box's sides, where Embree's packet-mode tests (16 lanes at once) and
+// its single-ray tests (one lane against 4 triangles) round apart.
+TEST(ShadowPackets, ALanesAnswerDependsNeitherOnItsLaneNorOnItsMates) {
+  constexpr size_t kMates = 14;  // the ray caster's packets (raytrace/ray_caster_parts.h, kShadowPacket)
+  std::vector<ContactScene> scenes;
+  scenes.push_back(contactSceneAt1e6());
+  for (const char* name : {"far-baked-1e6.gltf", "far-node-1e6.gltf", "grazing-lit-89.9.gltf"}) {
+    ContactScene s{loadScene(test::scenePath(std::string("stiff/") + name)), {}};
+    s.points = surfacePoints(s.scene);
+    s.points.resize(std::min<size_t>(s.points.size(), 1200));
+    scenes.push_back(std::move(s));
+  }
+  std::mt19937 rng(5);
+  size_t rays = 0, blocked = 0, lit = 0;
+  for (const ContactScene& cs : scenes) {
+    const Scene& scene = cs.scene;
+    const std::vector<SurfacePoint>& points = cs.points;
+    const std::string name = scene.path;
+    RayCaster caster(scene, analyzeScene(scene));
+    caster.bind(makeCamera(scene, {}, 16, 16), RayOptions{});
+    const ShadowRays r = grazingRays(scene, points, rng);
+    const size_t n = r.points.size();
+    std::vector<glm::vec3> alone(n);
+    for (size_t k = 0; k < n; ++k)
+      alone[k] = caster.transmittance(*r.points[k], 0, r.toLight[k], r.distance[k]);
+    auto expectSame = [&](size_t k, const glm::vec3& got, const char* how) {
+      ASSERT_TRUE(sameBits(got, alone[k]))
+          << name << " ray " << k << " " << how << ": (" << got.r << ", " << got.g << ", " << got.b
+          << ") alone in lane 0: (" << alone[k].r << ", " << alone[k].g << ", " << alone[k].b << ")";
+    };
+    int lanes[16];
+    std::iota(lanes, lanes + 16, 0);
+    glm::vec3 out[16];
+    for (size_t k = 0; k < n; ++k) {  // alone in lane 1 + k % 15
+      const int lane = int(1 + k % 15);
+      caster.transmittancesInLanes(1, &r.points[k], &r.toLight[k], &r.distance[k], &lane, out);
+      expectSame(k, out[0], "alone in another lane");
+    }
+    for (size_t first = 0; first + kMates <= n; first += kMates) {  // coherent mates, lanes permuted
+      std::shuffle(lanes, lanes + 16, rng);
+      caster.transmittancesInLanes(kMates, &r.points[first], &r.toLight[first], &r.distance[first], lanes,
+                                   out);
+      for (size_t k = 0; k < kMates; ++k) expectSame(first + k, out[k], "among coherent mates");
+    }
+    std::vector<size_t> order(n);
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::shuffle(order.begin(), order.end(), rng);
+    for (size_t first = 0; first < n;) {  // random mates, 2…14 of them, random lanes
+      const size_t m = std::min<size_t>(n - first, 2 + rng() % (kMates - 1));
+      const SurfacePoint* p[16];
+      glm::dvec3 d[16];
+      double t[16];
+      for (size_t k = 0; k < m; ++k) {
+        p[k] = r.points[order[first + k]];
+        d[k] = r.toLight[order[first + k]];
+        t[k] = r.distance[order[first + k]];
+      }
+      std::shuffle(lanes, lanes + 16, rng);
+      caster.transmittancesInLanes(m, p, d, t, lanes, out);
+      for (size_t k = 0; k < m; ++k) expectSame(order[first + k], out[k], "among random mates");
+      first += m;
+    }
+    caster.throwIfError();
+    for (const glm::vec3& a : alone) {
+      ++rays;
+      blocked += a == glm::vec3(0.0f);
+      lit += a == glm::vec3(1.0f);
+    }
+  }
+  // Not vacuous: rays blocked and rays that reach the light.
+  EXPECT_GT(blocked, 500u);
+  EXPECT_GT(lit, 500u);
+  std::printf("%zu rays: %zu blocked, %zu unoccluded\n", rays, blocked, lit);
 }
 
 }  // namespace
