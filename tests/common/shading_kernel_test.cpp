@@ -332,6 +332,33 @@ TEST(ShadingKernel, TracingAndBlendMaterialsTakeTheScalarPath) {
 // their run's base colour and emission, lanes that need their own (vertex
 // colours, a visibility callback) mixed with them in one block, the eye
 // light, and BLEND lanes on the scalar path.
+// Hits as the struct of arrays a PrimaryHitBlock reads (the fused pass's
+// output): directions, footprint positions and barycentrics.
+struct HitColumns {
+  std::vector<double> dx, dy, dz, fx, fy;
+  std::vector<float> b1, b2;
+  explicit HitColumns(const std::vector<ShadeHit>& hits)
+      : dx(hits.size()),
+        dy(hits.size()),
+        dz(hits.size()),
+        fx(hits.size()),
+        fy(hits.size()),
+        b1(hits.size()),
+        b2(hits.size()) {
+    for (size_t i = 0; i < hits.size(); ++i) {
+      dx[i] = hits[i].direction.x, dy[i] = hits[i].direction.y, dz[i] = hits[i].direction.z;
+      fx[i] = hits[i].footprintPosition.x, fy[i] = hits[i].footprintPosition.y;
+      b1[i] = hits[i].b1, b2[i] = hits[i].b2;
+    }
+  }
+  // Points `block`'s per-lane inputs at the hits from `first` on.
+  void into(PrimaryHitBlock& block, size_t first) {
+    block.dirX = &dx[first], block.dirY = &dy[first], block.dirZ = &dz[first];
+    block.b1 = &b1[first], block.b2 = &b2[first];
+    block.footprintX = &fx[first], block.footprintY = &fy[first];
+  }
+};
+
 TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
   const TintedVisibility tinted;
   Scene base = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
@@ -369,12 +396,8 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
     const size_t n = hits.size();
     std::vector<int32_t> run(n);
     std::vector<uint32_t> runInstance, runTriangle, runFirst, colorIndex(n), forward(n);
-    std::vector<double> dx(n), dy(n), dz(n), fx(n), fy(n);
-    std::vector<float> b1(n), b2(n);
+    HitColumns columns(hits);
     for (size_t i = 0; i < n; ++i) {
-      dx[i] = hits[i].direction.x, dy[i] = hits[i].direction.y, dz[i] = hits[i].direction.z;
-      fx[i] = hits[i].footprintPosition.x, fy[i] = hits[i].footprintPosition.y;
-      b1[i] = hits[i].b1, b2[i] = hits[i].b2;
       colorIndex[i] = uint32_t(n - 1 - i);
       forward[i] = uint32_t(i);
     }
@@ -411,9 +434,7 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
             block.run = &run[first];
             block.runInstance = runInstance.data();
             block.runTriangle = runTriangle.data();
-            block.dirX = &dx[first], block.dirY = &dy[first], block.dirZ = &dz[first];
-            block.b1 = &b1[first], block.b2 = &b2[first];
-            block.footprintX = &fx[first], block.footprintY = &fy[first];
+            columns.into(block, first);
             block.colorIndex = withRunFirst ? &forward[first] : &colorIndex[first];
             if (withRunFirst) {
               block.runs = runInstance.size();
@@ -455,14 +476,8 @@ TEST(ShadingKernel, RunCornersAndFaceNormalsGivenGiveTheKernelsOwnBits) {
     shadePrimaryHits(shader, hits.data(), n, expected.data(), ShadingPath::Kernel);
     std::vector<int32_t> run(n);
     std::vector<uint32_t> colorIndex(n);
-    std::vector<double> dx(n), dy(n), dz(n), fx(n), fy(n);
-    std::vector<float> b1(n), b2(n);
-    for (size_t i = 0; i < n; ++i) {
-      dx[i] = hits[i].direction.x, dy[i] = hits[i].direction.y, dz[i] = hits[i].direction.z;
-      fx[i] = hits[i].footprintPosition.x, fy[i] = hits[i].footprintPosition.y;
-      b1[i] = hits[i].b1, b2[i] = hits[i].b2;
-      colorIndex[i] = uint32_t(i);
-    }
+    HitColumns columns(hits);
+    for (size_t i = 0; i < n; ++i) colorIndex[i] = uint32_t(i);
     // wrong: every run given a wrong normal (its components rotated: the
     // liveness check; a reversed one would be faced back towards the eye).
     const auto shadeGiven = [&](bool wrong) {
@@ -494,9 +509,7 @@ TEST(ShadingKernel, RunCornersAndFaceNormalsGivenGiveTheKernelsOwnBits) {
         block.runTriangle = runTriangle.data();
         block.runCorners = corners.data();
         block.runFaceNormal = normals.data();
-        block.dirX = &dx[first], block.dirY = &dy[first], block.dirZ = &dz[first];
-        block.b1 = &b1[first], block.b2 = &b2[first];
-        block.footprintX = &fx[first], block.footprintY = &fy[first];
+        columns.into(block, first);
         block.colorIndex = &colorIndex[first];
         kernel.shade(block, got.data());
       }
