@@ -334,7 +334,9 @@ std::string refusal(const std::string& path, std::optional<double> time = 0.0, i
   try {
     loadAt(path, time, animation);
   } catch (const InputError& e) {
-    if (e.file() != "command line") EXPECT_EQ(e.file(), path);
+    if (e.file() != "command line") {
+      EXPECT_EQ(e.file(), path);  // braces: gtest's macro is an if-else (-Wdangling-else)
+    }
     return e.element() + ": " + e.message();
   }
   return "accepted";
