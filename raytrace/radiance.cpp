@@ -70,16 +70,21 @@ glm::vec3 traceRadiance(const CasterState& state, const RayTreeContext& context,
 
 namespace {
 
-// A shadow ray's first query from `point` towards unit `dir`: g set up
-// for it (mode, ray from the offset origin); returns the origin, and its
-// offset side in *side.
-glm::vec3 startShadowRay(const CasterState& state, const SurfacePoint& point, const glm::dvec3& dir,
-                         double distance, HitGather& g, glm::dvec3* side) {
+// g set up for a shadow ray's first query from `origin` along unit `dir`.
+void startShadowGather(const glm::vec3& origin, const glm::dvec3& dir, double distance, HitGather& g) {
   g.mode = GatherMode::Shadow;
   g.primary = false;
-  const glm::vec3 origin = secondaryRayOrigin(state, point, dir, side);
   g.ray = secondaryRay(origin, dir, distance);
   g.hits.clear();
+}
+
+// A shadow ray's first query from `point` towards unit `dir`: g set up
+// for it (startShadowGather from the offset origin); returns the origin,
+// and its offset side in *side.
+glm::vec3 startShadowRay(const CasterState& state, const SurfacePoint& point, const glm::dvec3& dir,
+                         double distance, HitGather& g, glm::dvec3* side) {
+  const glm::vec3 origin = secondaryRayOrigin(state, point, dir, side);
+  startShadowGather(origin, dir, distance, g);
   return origin;
 }
 
@@ -147,7 +152,7 @@ void traceTransmittances(const CasterState& state, const RayTreeContext& context
   for (size_t first = 0; first < n; first += kShadowPacket) {
     const size_t m = std::min(kShadowPacket, n - first);
     // The lanes' origins together (errorBoundRayOrigins: the certification
-    // in double SIMD lanes), then each lane's ray as startShadowRay sets it.
+    // in double SIMD lanes), then each lane's gather as startShadowRay sets it.
     FloatTriangle triangles[kShadowPacket];
     glm::dvec3 positions[kShadowPacket], lifts[kShadowPacket];
     float b1[kShadowPacket], b2[kShadowPacket];
@@ -168,13 +173,7 @@ void traceTransmittances(const CasterState& state, const RayTreeContext& context
         origins[k] = floatUlpsRayOrigin(glm::vec3(positions[k] + lifts[k]), glm::vec3(sides[k]));
     else
       errorBoundRayOrigins(m, triangles, positions, b1, b2, sides, lifts, origins);
-    for (size_t k = 0; k < m; ++k) {
-      HitGather& g = gathers[k];
-      g.mode = GatherMode::Shadow;
-      g.primary = false;
-      g.ray = secondaryRay(origins[k], dirs[k], distance[first + k]);
-      g.hits.clear();
-    }
+    for (size_t k = 0; k < m; ++k) startShadowGather(origins[k], dirs[k], distance[first + k], gathers[k]);
     traceOcclusionPacket(state, gathers, m, blocked, lanes);
     for (size_t k = 0; k < m; ++k)
       out[first + k] = finishTransmittance(state, context, *points[first + k], dirs[k], distance[first + k],
