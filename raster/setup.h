@@ -162,6 +162,14 @@ bool mayCoverSample(const TriangleSetup& t, const SampleGrid& grid);
 SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& depth,
                            const ClipVertex v[3], CullMode cull, TriangleSetup* out);
 
+// The same with the planes' scalar reference (one division per plane
+// coefficient and per vertex attribute, as written), which setupTriangle
+// and prepareTriangles match bit for bit with paired divisions: for the
+// equivalence test (tests/raster/setup_test.cpp).
+SetupOutcome setupTriangleScalarPlanes(const ClipSpace& space, const SampleGrid& grid,
+                                       const DepthSettings& depth, const ClipVertex v[3], CullMode cull,
+                                       TriangleSetup* out);
+
 struct SetupCounters {
   uint64_t trianglesIn = 0;
   uint64_t degenerate = 0;        // zero area in world space or after snapping

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <string>
 #include <thread>
+#include <tuple>
 
 #include <tbb/task_arena.h>
 
@@ -97,6 +98,41 @@ TEST(FrameBuffers, WireframeOverStaleTargetMatchesFresh) {
   pool.recycle(std::move(first.image));
   const RenderOutput second = test::render(triangle, camera, pooled);
   expectSameImage(second.image, fresh.image, "wireframe");
+}
+
+// The triangle setups and their refinement planes (hundreds of MB at
+// 10^6 triangles) live in the pool between frames: a second frame of the
+// same scene sets up into the first frame's storage (same address, same
+// capacity: no fresh pages mapped, faulted in and zeroed), and a frame
+// that needs less keeps the larger storage instead of shrinking it.
+TEST(FrameBuffers, SecondFrameSetsUpIntoTheFirstFramesStorage) {
+  const Scene cornell = loadScene(test::scenePath("cornell-box.gltf"));
+  const Scene triangle = oneTriangle();
+  const Camera camera = makeCamera(cornell, {}, 64, 48);
+  RasterOptions options;
+  options.shadows = RasterShadows::None;
+  RasterFrameBuffers pool;
+  RasterOptions pooled = options;
+  pooled.frameBuffers = &pool;
+  const auto storage = [&pool] {
+    FrameBufferLease lease(&pool);
+    return std::tuple(static_cast<const void*>(lease.setups().data()), lease.setups().capacity(),
+                      static_cast<const void*>(lease.planes().data()), lease.planes().capacity());
+  };
+  RenderOutput first = test::render(cornell, camera, pooled);
+  const auto [setups, setupCapacity, planes, planeCapacity] = storage();
+  ASSERT_NE(setups, nullptr);
+  ASSERT_NE(planes, nullptr);
+  EXPECT_GE(setupCapacity, size_t(first.counters.get("raster.triangles_setup")));
+  pool.recycle(std::move(first.image));
+  for (int frame = 0; frame < 2; ++frame) {
+    RenderOutput next = test::render(frame == 0 ? cornell : triangle, camera, pooled);
+    EXPECT_EQ(storage(), std::tuple(setups, setupCapacity, planes, planeCapacity)) << "frame " << frame;
+    pool.recycle(std::move(next.image));
+  }
+  // Without a pool each frame's storage is its own (and freed with it).
+  FrameBufferLease own(nullptr);
+  EXPECT_EQ(own.setups().capacity(), size_t(0));
 }
 
 // A pool in use by one frame: a second frame at the same time takes its

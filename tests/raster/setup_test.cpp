@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <random>
 
 #include "common/error.h"
@@ -180,6 +182,62 @@ TEST(Setup, DegenerateTrianglesCoverNothing) {
   addMesh(scene, {at(1.5, 1.5), at(1.5, 1.5), at(5.5, 5.5)}, {{0, 1, 2}});  // repeated vertex
   const auto c = countCoverage(scene, pixelCamera(), 4);
   for (size_t i = 0; i < c.front.size(); ++i) EXPECT_EQ(c.front[i] + c.back[i], 0);
+}
+
+// setupTriangle's planes (divisions paired, b/w of weights 0 and 1
+// without a division) against their scalar reference, bit for bit: random
+// triangles in clip space, perspective (w from 1e-3 to 1e3) and
+// orthographic (w = 1), unit weights (an unclipped triangle) and clipped
+// pieces' fractional ones with exact 0s and 1s among them, every depth
+// format, with and without polygon offset, both facings.
+RASTRAY_TEST_LABELS_OF(Setup, PairedPlaneDivisionsMatchTheScalarReferenceBitForBit, "quick");
+TEST(Setup, PairedPlaneDivisionsMatchTheScalarReferenceBitForBit) {
+  const auto bits = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  std::mt19937 rng(20261202);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const SampleGrid grid = makeSampleGrid(4, 96, 64);
+  Camera camera = orthoCamera(96, 1.0);
+  camera.height = 64;
+  const ClipSpace space = makeClipSpace(camera, grid.guardPixels);
+  size_t compared = 0;
+  for (int n = 0; n < 4000; ++n) {
+    const bool ortho = n % 4 == 3;
+    DepthSettings ds{DepthFormat(n % 4),
+                     ortho ? Projection::Orthographic : Projection::Perspective,
+                     0.1,
+                     100.0,
+                     n % 3 == 0 ? 1.5 : 0.0,
+                     n % 5 == 0 ? 2.0 : 0.0};
+    ClipVertex v[3];
+    for (int i = 0; i < 3; ++i) {
+      const double w = ortho ? 1.0 : std::pow(10.0, 6.0 * unit(rng) - 3.0);
+      v[i].position = {(2.0 * unit(rng) - 1.0) * w, (2.0 * unit(rng) - 1.0) * w, unit(rng) * w, w};
+      v[i].bary = glm::dvec3(0.0);
+      v[i].bary[i] = 1.0;
+    }
+    if (n % 2 == 1) {  // a clipped piece's weights: fractional, with exact 0s and 1s among them
+      for (int i = 0; i < 3; ++i) {
+        const int kind = int(unit(rng) * 3.0);
+        if (kind == 0) continue;  // keeps its unit weights
+        const double a = kind == 1 ? unit(rng) : 0.0;
+        v[i].bary = {1.0 - a, a, 0.0};
+        if (unit(rng) < 0.5) std::swap(v[i].bary.y, v[i].bary.z);
+      }
+    }
+    TriangleSetup fast, scalar;
+    const SetupOutcome a = setupTriangle(space, grid, ds, v, CullMode::None, &fast);
+    const SetupOutcome b = setupTriangleScalarPlanes(space, grid, ds, v, CullMode::None, &scalar);
+    ASSERT_EQ(a, b) << n;
+    if (a != SetupOutcome::Ok) continue;
+    ++compared;
+    ASSERT_TRUE(bits(fast.depth, scalar.depth)) << n;
+    ASSERT_TRUE(bits(fast.invW, scalar.invW)) << n;
+    ASSERT_TRUE(bits(fast.dOverW, scalar.dOverW)) << n;
+    ASSERT_TRUE(bits(fast.b1OverW, scalar.b1OverW)) << n;
+    ASSERT_TRUE(bits(fast.b2OverW, scalar.b2OverW)) << n;
+    for (int e = 0; e < 3; ++e) ASSERT_EQ(fast.edge[e].original, scalar.edge[e].original) << n;
+  }
+  EXPECT_GT(compared, size_t(3000));
 }
 
 RASTRAY_TEST_LABELS_OF(Clip, NearPlaneSplitsKeepParentBarycentricsAndShareVertices, "quick");
