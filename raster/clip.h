@@ -39,6 +39,10 @@ struct ClipVertex {
 // 3 vertices + at most one more per plane (6 planes).
 constexpr int kMaxClipVertices = 9;
 
+// Two doubles in one register (GCC/Clang vector extension: SSE2's divpd on
+// x86-64): two correctly rounded IEEE divisions for the price of one.
+typedef double ClipPair __attribute__((vector_size(16)));
+
 struct ClipSpace {
   Projection projection = Projection::Perspective;
   glm::dmat4 viewFromWorld{1.0};
@@ -48,12 +52,26 @@ struct ClipSpace {
   glm::dvec2 guard{1.0};  // guard band half extents in NDC (>= 1)
 
   ClipVertex project(const glm::dvec3& view, const glm::dvec3& bary) const;
-  // A world point's clip position: view transform in double, then project.
+  // A world point's clip position: view transform in double, then
+  // project's divisions by the scale, the two in one register
+  // (clipOfReference's bits: IEEE division is correctly rounded per lane).
+  // Setup calls it for every vertex and again for every kept triangle's.
   glm::dvec4 clipOf(const glm::dvec3& world) const {
+    const glm::dvec4 view = viewFromWorld * glm::dvec4(world, 1.0);
+    const double d = -view.z;
+    const ClipPair xy = ClipPair{view.x, view.y} / ClipPair{scale.x, scale.y};
+    return {xy[0], xy[1], d, projection == Projection::Perspective ? d : 1.0};
+  }
+  glm::dvec4 clipOfReference(const glm::dvec3& world) const {
     return project(glm::dvec3(viewFromWorld * glm::dvec4(world, 1.0)), glm::dvec3(0.0)).position;
   }
-  // Image position (pixels, y down) of a clip vertex with w > 0.
+  // Image position (pixels, y down) of a clip vertex with w > 0; the two
+  // divisions by w in one register, imageOfReference's bits.
   glm::dvec2 imageOf(const glm::dvec4& clip) const {
+    const ClipPair q = ClipPair{clip.x, clip.y} / ClipPair{clip.w, clip.w};
+    return {(q[0] + 1.0) * 0.5 * width, (1.0 - q[1]) * 0.5 * height};
+  }
+  glm::dvec2 imageOfReference(const glm::dvec4& clip) const {
     return {(clip.x / clip.w + 1.0) * 0.5 * width, (1.0 - clip.y / clip.w) * 0.5 * height};
   }
 };

@@ -51,9 +51,7 @@ SampleGrid makeSampleGrid(int spp, int width, int height) {
 
 namespace {
 
-// Two doubles in one register (GCC/Clang vector extension): SSE2's divpd
-// on x86-64, two correctly rounded IEEE divisions.
-typedef double Double2 __attribute__((vector_size(16)));
+using Double2 = ClipPair;  // raster/clip.h
 
 // The plane through (x[i], y[i], a[i]), with its origin at vertex 0.
 PlaneCoefficients makeCoefficients(const double x[3], const double y[3], const double a[3], double area2) {
@@ -335,7 +333,7 @@ SetupOutcome setupTriangleScalarPlanes(const ClipSpace& space, const SampleGrid&
   return setUp<true>(space, grid, ds, v, cull, t);
 }
 
-bool mayCoverSample(const TriangleSetup& t, const SampleGrid& grid) {
+bool mayCoverSampleReference(const TriangleSetup& t, const SampleGrid& grid) {
   const int64_t w = int64_t(t.pixelMax.x) - t.pixelMin.x + 1, h = int64_t(t.pixelMax.y) - t.pixelMin.y + 1;
   if (w * h * grid.spp > kSampleSearchLimit) return true;
   const int64_t U = grid.unitsPerPixel;
@@ -348,6 +346,35 @@ bool mayCoverSample(const TriangleSetup& t, const SampleGrid& grid) {
             t.edge[2].at(X, Y) + t.edge[2].bias >= 0)
           return true;
       }
+  return false;
+}
+
+bool mayCoverSample(const TriangleSetup& t, const SampleGrid& grid) {
+  const int64_t w = int64_t(t.pixelMax.x) - t.pixelMin.x + 1, h = int64_t(t.pixelMax.y) - t.pixelMin.y + 1;
+  if (w * h * grid.spp > kSampleSearchLimit) return true;
+  // A sample that passes the three edge tests lies in the closed triangle
+  // (E >= -bias >= 0), so in its vertices' box: only the samples of the
+  // pixel bounds inside that box are tested (boxHoldsSample's ranges),
+  // per sample position. The same answer as mayCoverSampleReference.
+  const int64_t minX = std::min({t.vertex[0].x, t.vertex[1].x, t.vertex[2].x});
+  const int64_t maxX = std::max({t.vertex[0].x, t.vertex[1].x, t.vertex[2].x});
+  const int64_t minY = std::min({t.vertex[0].y, t.vertex[1].y, t.vertex[2].y});
+  const int64_t maxY = std::max({t.vertex[0].y, t.vertex[1].y, t.vertex[2].y});
+  const int64_t U = grid.unitsPerPixel;
+  for (const glm::i64vec2& o : grid.offsets) {
+    const int64_t x0 = std::max<int64_t>(t.pixelMin.x, -floorDiv(o.x - minX, U));
+    const int64_t x1 = std::min<int64_t>(t.pixelMax.x, floorDiv(maxX - o.x, U));
+    const int64_t y0 = std::max<int64_t>(t.pixelMin.y, -floorDiv(o.y - minY, U));
+    const int64_t y1 = std::min<int64_t>(t.pixelMax.y, floorDiv(maxY - o.y, U));
+    for (int64_t py = y0; py <= y1; ++py)
+      for (int64_t px = x0; px <= x1; ++px) {
+        // Inside the image: within setup.h's exact int64 range.
+        const int64_t X = px * U + o.x, Y = py * U + o.y;
+        if (t.edge[0].at(X, Y) + t.edge[0].bias >= 0 && t.edge[1].at(X, Y) + t.edge[1].bias >= 0 &&
+            t.edge[2].at(X, Y) + t.edge[2].bias >= 0)
+          return true;
+      }
+  }
   return false;
 }
 

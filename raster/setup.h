@@ -157,6 +157,10 @@ constexpr int kSampleSearchLimit = 64;
 // sample: they are dropped before their planes are computed or stored.
 bool mayCoverSample(const TriangleSetup& t, const SampleGrid& grid);
 
+// The same by testing every sample of the pixel bounds (mayCoverSample
+// tests only those inside the vertices' box): the equivalence tests' reference.
+bool mayCoverSampleReference(const TriangleSetup& t, const SampleGrid& grid);
+
 // Sets up one clipped triangle (three clip vertices with w > 0).
 // `cull`: which facing to drop (None keeps both).
 SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const DepthSettings& depth,

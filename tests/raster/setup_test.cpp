@@ -240,6 +240,68 @@ TEST(Setup, PairedPlaneDivisionsMatchTheScalarReferenceBitForBit) {
   EXPECT_GT(compared, size_t(3000));
 }
 
+// mayCoverSample tests only the samples inside the vertices' box; its
+// reference tests every sample of the pixel bounds. Random small
+// triangles (up to 3 pixels across, so most are searched) at 1, 4, 16
+// and 25 (k = 5: no power-of-two units) samples per pixel, partly off the
+// image, both orientations: the same answer every time, and both answers
+// occur.
+RASTRAY_TEST_LABELS_OF(Setup, BoxedSampleSearchMatchesTheFullSearch, "quick");
+TEST(Setup, BoxedSampleSearchMatchesTheFullSearch) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const int spp : {1, 4, 16, 25}) {
+    const SampleGrid grid = makeSampleGrid(spp, 40, 30);
+    Camera camera = orthoCamera(40, 1.0);
+    camera.height = 30;
+    const ClipSpace space = makeClipSpace(camera, grid.guardPixels);
+    const DepthSettings ds{DepthFormat::FloatReversed, Projection::Orthographic, 0.1, 100.0, 0, 0};
+    size_t covers = 0, misses = 0;
+    for (int n = 0; n < 6000; ++n) {
+      // Image position (pixels) to clip x, y with w = 1.
+      const double cx = -2.0 + 44.0 * unit(rng), cy = -2.0 + 34.0 * unit(rng), size = 3.0 * unit(rng);
+      ClipVertex v[3];
+      for (int i = 0; i < 3; ++i) {
+        const double px = cx + size * unit(rng), py = cy + size * unit(rng);
+        v[i].position = {2.0 * px / 40.0 - 1.0, 1.0 - 2.0 * py / 30.0, 0.5, 1.0};
+        v[i].bary = glm::dvec3(0.0);
+        v[i].bary[i] = 1.0;
+      }
+      TriangleSetup t;
+      if (setupTriangle(space, grid, ds, v, CullMode::None, &t) != SetupOutcome::Ok) continue;
+      const bool reference = mayCoverSampleReference(t, grid);
+      ASSERT_EQ(mayCoverSample(t, grid), reference) << "spp " << spp << " triangle " << n;
+      ++(reference ? covers : misses);
+    }
+    EXPECT_GT(covers, size_t(100)) << spp;
+    EXPECT_GT(misses, size_t(100)) << spp;
+  }
+}
+
+// ClipSpace's clipOf and imageOf (two divisions in one register) against
+// their scalar references, bit for bit: perspective and orthographic,
+// points near and far, in front and behind.
+RASTRAY_TEST_LABELS_OF(Clip, PairedDivisionsMatchTheScalarReferenceBitForBit, "quick");
+TEST(Clip, PairedDivisionsMatchTheScalarReferenceBitForBit) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  for (const bool ortho : {false, true}) {
+    Camera camera = ortho ? orthoCamera(97, 1.3)
+                          : test::perspectiveCamera(97, 61, 0.7, {0.3, -0.2, 5.0}, {0.0, 0.1, 0.0});
+    camera.height = 61;
+    const ClipSpace space = makeClipSpace(camera, 100.0);
+    for (int n = 0; n < 5000; ++n) {
+      const double scale = std::pow(10.0, 4.0 * unit(rng));
+      const glm::dvec3 world(unit(rng) * scale, unit(rng) * scale, unit(rng) * scale);
+      const glm::dvec4 clip = space.clipOf(world);
+      ASSERT_TRUE(same(clip, space.clipOfReference(world))) << n;
+      if (!(clip.w > 0.0)) continue;
+      ASSERT_TRUE(same(space.imageOf(clip), space.imageOfReference(clip))) << n;
+    }
+  }
+}
+
 RASTRAY_TEST_LABELS_OF(Clip, NearPlaneSplitsKeepParentBarycentricsAndShareVertices, "quick");
 TEST(Clip, NearPlaneSplitsKeepParentBarycentricsAndShareVertices) {
   Camera camera = test::perspectiveCamera(32, 32, 1.0, glm::dvec3(0), glm::dvec3(0, 0, -1), 0.5);
