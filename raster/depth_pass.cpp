@@ -253,9 +253,10 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     if (!keysOnly) winners[i] = index;
   };
 
-  // A triangle whose pixels within the rect lie in one block and hold at
-  // most this many samples takes the small-triangle path below.
-  constexpr int kSmallSamples = 16;
+  // A triangle whose pixels within the rect span at most a block's width
+  // and height and hold at most this many samples takes the
+  // small-triangle path below (masks of 64 bits: 64 samples at most).
+  constexpr int kSmallSamples = 64;
   alignas(16) int64_t smallOffsets[3][kSmallSamples];
   uint64_t smallMasks[kSmallSamples];
   // The next triangles' setups (304 bytes each, mostly not in cache at
@@ -379,39 +380,89 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     };
     constexpr int B = kCoverageBlock;
     const int w = r.x1 - r.x0 + 1, h = r.y1 - r.y0 + 1;
-    if ((r.x0 - rect.x0) / B == (r.x1 - rect.x0) / B && (r.y0 - rect.y0) / B == (r.y1 - rect.y0) / B &&
-        w * h * spp <= kSmallSamples) {
-      // Small triangle: its pixels lie in one block and hold a few samples.
-      // Their masks straight from the edge functions, E + bias >= 0 at
-      // each sample (exact int64: the rule block_coverage.h's masks
-      // implement), without classifying the block or preparing its int32
-      // lanes; then the block's hierarchical test, the depth tests in the
-      // partial-block order (sample, then pixel) and the same counts, so
-      // the keys, winners and counters are the block walk's.
+    if (w <= B && h <= B && w * h * spp <= kSmallSamples) {
+      // Small triangle: its pixels within the rect span at most 8 × 8 (so
+      // at most 2 × 2 blocks) and hold a few samples. Their masks straight
+      // from the edge functions over its bounds, E + bias >= 0 at each
+      // sample (exact int64: the rule block_coverage.h's masks implement;
+      // E stepped by a·U and b·U from the bounds' corner, each step an E
+      // at a pixel corner in the image, so the same integers as at()),
+      // with bit 8·j + i for pixel (r.x0 + i, r.y0 + j), without
+      // classifying blocks or preparing their int32 lanes. Then per block
+      // of the rect holding a covered sample: its hierarchical test (on
+      // the block clipped to the bounds, as the block walk's), the depth
+      // tests of its samples in the partial-block order (sample, then
+      // pixel) and the same counts. A block the walk would visit that
+      // holds no covered sample is skipped: it tests and writes nothing,
+      // and whether it is culled counts nothing either, so the keys,
+      // winners and counters are the block walk's.
       for (int e = 0; e < 3; ++e)
         for (int k = 0; k < spp; ++k)
           smallOffsets[e][k] =
               t.edge[e].a * grid.offsets[size_t(k)].x + t.edge[e].b * grid.offsets[size_t(k)].y;
+      const int64_t X0 = int64_t(r.x0) * U, Y0 = int64_t(r.y0) * U;
+      int64_t row0 = t.edge[0].at(X0, Y0) + t.edge[0].bias, row1 = t.edge[1].at(X0, Y0) + t.edge[1].bias,
+              row2 = t.edge[2].at(X0, Y0) + t.edge[2].bias;
+      const int64_t stepX0 = int64_t(t.edge[0].a) * U, stepX1 = int64_t(t.edge[1].a) * U,
+                    stepX2 = int64_t(t.edge[2].a) * U;
+      const int64_t stepY0 = int64_t(t.edge[0].b) * U, stepY1 = int64_t(t.edge[1].b) * U,
+                    stepY2 = int64_t(t.edge[2].b) * U;
       uint64_t any = 0;
-      for (int k = 0; k < spp; ++k) smallMasks[k] = 0;
-      for (int j = 0; j < h; ++j)
-        for (int i = 0; i < w; ++i) {
-          const int64_t X = int64_t(r.x0 + i) * U, Y = int64_t(r.y0 + j) * U;
-          const int64_t e0 = t.edge[0].at(X, Y) + t.edge[0].bias;
-          const int64_t e1 = t.edge[1].at(X, Y) + t.edge[1].bias;
-          const int64_t e2 = t.edge[2].at(X, Y) + t.edge[2].bias;
-          for (int k = 0; k < spp; ++k) {
-            const bool in = (e0 + smallOffsets[0][k] >= 0) & (e1 + smallOffsets[1][k] >= 0) &
-                            (e2 + smallOffsets[2][k] >= 0);
-            smallMasks[k] |= uint64_t(in) << (8 * j + i);
+      if (spp == 1) {
+        const int64_t o0 = smallOffsets[0][0], o1 = smallOffsets[1][0], o2 = smallOffsets[2][0];
+        for (int j = 0; j < h; ++j) {
+          int64_t e0 = row0 + o0, e1 = row1 + o1, e2 = row2 + o2;
+          for (int i = 0; i < w; ++i) {
+            // Every one >= 0: their sign bits all clear.
+            any |= uint64_t(~(e0 | e1 | e2)) >> 63 << (8 * j + i);
+            e0 += stepX0, e1 += stepX1, e2 += stepX2;
           }
+          row0 += stepY0, row1 += stepY1, row2 += stepY2;
         }
-      for (int k = 0; k < spp; ++k) any |= smallMasks[k];
+        smallMasks[0] = any;
+      } else {
+        for (int k = 0; k < spp; ++k) smallMasks[k] = 0;
+        for (int j = 0; j < h; ++j) {
+          int64_t e0 = row0, e1 = row1, e2 = row2;
+          for (int i = 0; i < w; ++i) {
+            for (int k = 0; k < spp; ++k) {
+              const int64_t m =
+                  (e0 + smallOffsets[0][k]) | (e1 + smallOffsets[1][k]) | (e2 + smallOffsets[2][k]);
+              smallMasks[k] |= uint64_t(~m) >> 63 << (8 * j + i);
+            }
+            e0 += stepX0, e1 += stepX1, e2 += stepX2;
+          }
+          row0 += stepY0, row1 += stepY1, row2 += stepY2;
+        }
+        for (int k = 0; k < spp; ++k) any |= smallMasks[k];
+      }
       if (any == 0) continue;
-      const PixelBlock b{r.x0, r.y0, w, h};
-      const size_t hb = bounds.block(r.x0, r.y0);
-      if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
-      testMaskedSamples(r.x0, r.y0, smallMasks, hb);
+      const int bx0 = rect.x0 + (r.x0 - rect.x0) / B * B, by0 = rect.y0 + (r.y0 - rect.y0) / B * B;
+      if (bx0 + B > r.x1 && by0 + B > r.y1) {  // one block
+        const PixelBlock b{r.x0, r.y0, w, h};
+        const size_t hb = bounds.block(r.x0, r.y0);
+        if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
+        testMaskedSamples(r.x0, r.y0, smallMasks, hb);
+        continue;
+      }
+      for (int by = by0; by <= r.y1; by += B)
+        for (int bx = bx0; bx <= r.x1; bx += B) {
+          const int cx0 = std::max(bx, r.x0), cy0 = std::max(by, r.y0);
+          const int cw = std::min(bx + B - 1, r.x1) - cx0 + 1, ch = std::min(by + B - 1, r.y1) - cy0 + 1;
+          // The bits of the bounds' mask within this block: its columns in
+          // each of its rows.
+          const uint64_t columns = ((uint64_t(1) << cw) - 1) << (cx0 - r.x0);
+          const uint64_t rows = (ch == B ? ~uint64_t(0) : (uint64_t(1) << (8 * ch)) - 1)
+                                << (8 * (cy0 - r.y0));
+          const uint64_t select = columns * 0x0101010101010101ull & rows;
+          if ((any & select) == 0) continue;
+          const PixelBlock b{cx0, cy0, cw, ch};
+          const size_t hb = bounds.block(bx, by);
+          if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
+          uint64_t pieceMasks[kSmallSamples];
+          for (int k = 0; k < spp; ++k) pieceMasks[k] = smallMasks[k] & select;
+          testMaskedSamples(r.x0, r.y0, pieceMasks, hb);
+        }
       continue;
     }
     prepareOffsets(t, grid, scratch);
