@@ -223,6 +223,10 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
   const int spp = grid.spp;
   const int64_t U = grid.unitsPerPixel;
   BlockDepthBounds bounds(*target, rect, clearedRect);
+  // DepthTarget::index's terms, held here (the key and winner stores
+  // would otherwise make the compiler reload them per sample).
+  const size_t targetWidth = size_t(target->width);
+  const int targetX0 = target->x0, targetY0 = target->y0;
   glm::dvec2 lowPos(1.0), highPos(0.0);
   for (const glm::dvec2& q : grid.positions) {
     lowPos = glm::min(lowPos, q);
@@ -340,7 +344,8 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     // one sample of the block `written` counts for.
     const auto testKey = [&](int px, int py, int s, uint32_t key, uint32_t& written, uint32_t& writtenMax)
         __attribute__((always_inline)) {
-      const size_t i = target->index(px, py, s);
+      const size_t i =
+          (size_t(py - targetY0) * targetWidth + size_t(px - targetX0)) * size_t(spp) + size_t(s);
       const uint32_t stored = keys[i];
       if (key > stored) return;
       if (key == stored &&
@@ -363,16 +368,21 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     const auto testMaskedSamples = [&](int x0, int y0, const uint64_t* sampleMasks, size_t hb)
         __attribute__((always_inline)) {
       uint32_t written = 0, writtenMax = 0;
+      int tested = 0;
       for (int s = 0; s < spp; ++s) {
         uint64_t m = sampleMasks[s];
-        counters->samplesTested += uint64_t(bitCount(m));
+        tested += bitCount(m);
+        const glm::dvec2 q = grid.positions[size_t(s)];
         while (m) {
           const int bit = __builtin_ctzll(m);
           m &= m - 1;
           const int px = x0 + (bit & 7), py = y0 + (bit >> 3);
-          testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s), written, writtenMax);
+          // sampleDepthKey's operations (the position px + q.x, py + q.y).
+          testKey(px, py, s, depthKey(format, t.depth.at(double(px) + q.x, double(py) + q.y)), written,
+                  writtenMax);
         }
       }
+      counters->samplesTested += uint64_t(tested);
       if (written != 0) {
         bounds.addWrites(hb, written);
         bounds.markStale(hb);
