@@ -1,5 +1,9 @@
 // Pass 1's depth test and write (rasterDepthPass, coverage.h).
 //
+// A triangle whose bounds within the tile span at most 8 × 8 pixels and 64
+// samples (nearly every triangle of a 10^6-triangle terrain at 1080p) takes
+// the small-triangle path: its masks over its bounds straight from the
+// edge functions, then per block it touches the same steps as below.
 // The fast path walks each triangle block by block (block_coverage.h) and
 // tests the covered samples of a block from its masks; a block the
 // triangle covers whole, eight pixels wide, is tested and written in SIMD
