@@ -1,5 +1,9 @@
 // Pass 1's depth test and write (rasterDepthPass, coverage.h).
 //
+// A triangle whose bounds within the tile span at most 8 × 8 pixels and 64
+// samples (nearly every triangle of a 10^6-triangle terrain at 1080p) takes
+// the small-triangle path: its masks over its bounds straight from the
+// edge functions, then per block it touches the same steps as below.
 // The fast path walks each triangle block by block (block_coverage.h) and
 // tests the covered samples of a block from its masks; a block the
 // triangle covers whole, eight pixels wide, is tested and written in SIMD
@@ -68,7 +72,10 @@ class BlockDepthBounds {
         bound_(size_t(columns_) * size_t((rect.y1 - rect.y0 + kCoverageBlock - 1) / kCoverageBlock),
                kClearDepthKey),
         stale_(bound_.size(), 1),
-        writes_(bound_.size(), cleared ? 0u : UINT32_MAX) {}
+        left_(bound_.size(), 0) {
+    if (cleared)
+      for (size_t b = 0; b < left_.size(); ++b) left_[b] = blockSamples(b, target.spp);
+  }
 
   size_t block(int x, int y) const {
     return size_t((y - rect_.y0) / kCoverageBlock) * size_t(columns_) +
@@ -80,12 +87,11 @@ class BlockDepthBounds {
   // A block of a cleared rect where fewer samples were written than it
   // holds still has a sample at kClearDepthKey, so its bound is that key
   // and nothing is culled there: known without refreshing (reading its
-  // keys), which small triangles would otherwise do once each. `spp`: the
-  // target's samples per pixel.
+  // keys), which small triangles would otherwise do once each.
   template <typename F>
-  bool culls(size_t b, int spp, F lowestKey) {
+  bool culls(size_t b, F lowestKey) {
     if (bound_[b] == kClearDepthKey && !stale_[b]) return false;
-    if (writes_[b] < blockSamples(b, spp)) return false;
+    if (left_[b] != 0) return false;
     const uint32_t lowest = lowestKey();
     if (lowest > bound_[b]) return true;
     if (!stale_[b]) return false;
@@ -94,9 +100,7 @@ class BlockDepthBounds {
   }
   void markStale(size_t b) { stale_[b] = 1; }
   // `n` samples of block b were written (by the fast walk, which counts).
-  void addWrites(size_t b, uint32_t n) {
-    writes_[b] = n > UINT32_MAX - writes_[b] ? UINT32_MAX : writes_[b] + n;
-  }
+  void addWrites(size_t b, uint32_t n) { left_[b] = n >= left_[b] ? 0 : left_[b] - n; }
   // Every sample of block b was just written, the largest key being `key`.
   void setExact(size_t b, uint32_t key) {
     bound_[b] = key;
@@ -116,7 +120,7 @@ class BlockDepthBounds {
     for (int y = rect_.y0 + (r.y0 - rect_.y0) / B * B; y <= r.y1; y += B)
       for (int x = rect_.x0 + (r.x0 - rect_.x0) / B * B; x <= r.x1; x += B) {
         stale_[block(x, y)] = 1;
-        writes_[block(x, y)] = UINT32_MAX;
+        left_[block(x, y)] = 0;
       }
   }
 
@@ -144,10 +148,12 @@ class BlockDepthBounds {
   int columns_;
   std::vector<uint32_t> bound_;
   std::vector<uint8_t> stale_;
-  // Samples written per block since the pass began on a cleared rect (a
-  // count, not distinct samples; saturating; UINT32_MAX: unknown, and
-  // always so when the rect was not cleared).
-  std::vector<uint32_t> writes_;
+  // Per block, its samples less the writes counted since the pass began
+  // on a cleared rect (a count of writes, not of distinct samples; 0 once
+  // they reach the samples, when unknown, and always when the rect was
+  // not cleared): while above 0, a sample of the block still holds
+  // kClearDepthKey. (A count down, so culls() divides nothing.)
+  std::vector<uint32_t> left_;
 };
 
 // Whether none of the eight keys equals its stored key (then bit k of
@@ -179,6 +185,34 @@ inline bool rowLess(const uint32_t (&keys)[8], const uint32_t* stored, uint32_t*
 #endif
 }
 
+#if defined(__SSE2__)
+// The small-triangle path's coverage of rows [0, h) of its bounds at one
+// sample: r0, r1, r2 each edge's E + bias + offset at the row's first
+// pixel, stepped by s0, s1, s2 a row; col[e][v] the lanes' column terms
+// (columns 2v, 2v + 1: that many times a·U). Bit 8·j + i set when every
+// edge's sum at pixel (i, j) is >= 0 (int64, exact: each sum is an edge
+// function at a sample of the image or of the eight pixels right of a
+// row's first, well within its range); columns from 2·V on are left to
+// the caller to mask.
+template <int V>
+inline uint64_t smallRows(const __m128i (&col)[3][4], int64_t r0, int64_t r1, int64_t r2, int64_t s0,
+                          int64_t s1, int64_t s2, int h) {
+  uint64_t m = 0;
+  for (int j = 0; j < h; ++j) {
+    const __m128i b0 = _mm_set1_epi64x(r0), b1 = _mm_set1_epi64x(r1), b2 = _mm_set1_epi64x(r2);
+    uint32_t failed = 0;
+    for (int v = 0; v < V; ++v) {
+      const __m128i x = _mm_or_si128(_mm_or_si128(_mm_add_epi64(b0, col[0][v]), _mm_add_epi64(b1, col[1][v])),
+                                     _mm_add_epi64(b2, col[2][v]));
+      failed |= uint32_t(_mm_movemask_pd(_mm_castsi128_pd(x))) << (2 * v);
+    }
+    m |= uint64_t(~failed & 0xFFu) << (8 * j);
+    r0 += s0, r1 += s1, r2 += s2;
+  }
+  return m;
+}
+#endif
+
 }  // namespace
 
 void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector<uint32_t>& bin,
@@ -193,6 +227,10 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
   const int spp = grid.spp;
   const int64_t U = grid.unitsPerPixel;
   BlockDepthBounds bounds(*target, rect, clearedRect);
+  // DepthTarget::index's terms, held here (the key and winner stores
+  // would otherwise make the compiler reload them per sample).
+  const size_t targetWidth = size_t(target->width);
+  const int targetX0 = target->x0, targetY0 = target->y0;
   glm::dvec2 lowPos(1.0), highPos(0.0);
   for (const glm::dvec2& q : grid.positions) {
     lowPos = glm::min(lowPos, q);
@@ -253,9 +291,10 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     if (!keysOnly) winners[i] = index;
   };
 
-  // A triangle whose pixels within the rect lie in one block and hold at
-  // most this many samples takes the small-triangle path below.
-  constexpr int kSmallSamples = 16;
+  // A triangle whose pixels within the rect span at most a block's width
+  // and height and hold at most this many samples takes the
+  // small-triangle path below (masks of 64 bits: 64 samples at most).
+  constexpr int kSmallSamples = 64;
   alignas(16) int64_t smallOffsets[3][kSmallSamples];
   uint64_t smallMasks[kSmallSamples];
   // The next triangles' setups (304 bytes each, mostly not in cache at
@@ -309,7 +348,8 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     // one sample of the block `written` counts for.
     const auto testKey = [&](int px, int py, int s, uint32_t key, uint32_t& written, uint32_t& writtenMax)
         __attribute__((always_inline)) {
-      const size_t i = target->index(px, py, s);
+      const size_t i =
+          (size_t(py - targetY0) * targetWidth + size_t(px - targetX0)) * size_t(spp) + size_t(s);
       const uint32_t stored = keys[i];
       if (key > stored) return;
       if (key == stored &&
@@ -332,16 +372,21 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     const auto testMaskedSamples = [&](int x0, int y0, const uint64_t* sampleMasks, size_t hb)
         __attribute__((always_inline)) {
       uint32_t written = 0, writtenMax = 0;
+      int tested = 0;
       for (int s = 0; s < spp; ++s) {
         uint64_t m = sampleMasks[s];
-        counters->samplesTested += uint64_t(bitCount(m));
+        tested += bitCount(m);
+        const glm::dvec2 q = grid.positions[size_t(s)];
         while (m) {
           const int bit = __builtin_ctzll(m);
           m &= m - 1;
           const int px = x0 + (bit & 7), py = y0 + (bit >> 3);
-          testKey(px, py, s, sampleDepthKey(t, grid, format, px, py, s), written, writtenMax);
+          // sampleDepthKey's operations (the position px + q.x, py + q.y).
+          testKey(px, py, s, depthKey(format, t.depth.at(double(px) + q.x, double(py) + q.y)), written,
+                  writtenMax);
         }
       }
+      counters->samplesTested += uint64_t(tested);
       if (written != 0) {
         bounds.addWrites(hb, written);
         bounds.markStale(hb);
@@ -379,39 +424,100 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
     };
     constexpr int B = kCoverageBlock;
     const int w = r.x1 - r.x0 + 1, h = r.y1 - r.y0 + 1;
-    if ((r.x0 - rect.x0) / B == (r.x1 - rect.x0) / B && (r.y0 - rect.y0) / B == (r.y1 - rect.y0) / B &&
-        w * h * spp <= kSmallSamples) {
-      // Small triangle: its pixels lie in one block and hold a few samples.
-      // Their masks straight from the edge functions, E + bias >= 0 at
-      // each sample (exact int64: the rule block_coverage.h's masks
-      // implement), without classifying the block or preparing its int32
-      // lanes; then the block's hierarchical test, the depth tests in the
-      // partial-block order (sample, then pixel) and the same counts, so
-      // the keys, winners and counters are the block walk's.
+    if (w <= B && h <= B && w * h * spp <= kSmallSamples) {
+      // Small triangle: its pixels within the rect span at most 8 × 8 (so
+      // at most 2 × 2 blocks) and hold a few samples. Their masks straight
+      // from the edge functions over its bounds, E + bias >= 0 at each
+      // sample (exact int64: the rule block_coverage.h's masks implement;
+      // E stepped by a·U and b·U from the bounds' corner, each step an E
+      // at a pixel corner in the image, so the same integers as at()),
+      // with bit 8·j + i for pixel (r.x0 + i, r.y0 + j), without
+      // classifying blocks or preparing their int32 lanes. Then per block
+      // of the rect holding a covered sample: its hierarchical test (on
+      // the block clipped to the bounds, as the block walk's), the depth
+      // tests of its samples in the partial-block order (sample, then
+      // pixel) and the same counts. A block the walk would visit that
+      // holds no covered sample is skipped: it tests and writes nothing,
+      // and whether it is culled counts nothing either, so the keys,
+      // winners and counters are the block walk's.
       for (int e = 0; e < 3; ++e)
         for (int k = 0; k < spp; ++k)
           smallOffsets[e][k] =
               t.edge[e].a * grid.offsets[size_t(k)].x + t.edge[e].b * grid.offsets[size_t(k)].y;
+      const int64_t X0 = int64_t(r.x0) * U, Y0 = int64_t(r.y0) * U;
+      int64_t row0 = t.edge[0].at(X0, Y0) + t.edge[0].bias, row1 = t.edge[1].at(X0, Y0) + t.edge[1].bias,
+              row2 = t.edge[2].at(X0, Y0) + t.edge[2].bias;
+      const int64_t stepX0 = int64_t(t.edge[0].a) * U, stepX1 = int64_t(t.edge[1].a) * U,
+                    stepX2 = int64_t(t.edge[2].a) * U;
+      const int64_t stepY0 = int64_t(t.edge[0].b) * U, stepY1 = int64_t(t.edge[1].b) * U,
+                    stepY2 = int64_t(t.edge[2].b) * U;
       uint64_t any = 0;
+      const uint64_t columns = ((uint64_t(1) << w) - 1) * 0x0101010101010101ull;
+#if defined(__SSE2__)
+      // Two columns a vector (int64 lanes: i·a·U added to the row's E),
+      // a pixel covered when the three sums' sign bits are clear
+      // (MOVMSKPD reads them); columns past w masked off after.
+      __m128i col[3][4];
+      const int64_t stepX[3] = {stepX0, stepX1, stepX2};
+      for (int e = 0; e < 3; ++e) {
+        const __m128i two = _mm_set1_epi64x(2 * stepX[e]);
+        col[e][0] = _mm_set_epi64x(stepX[e], 0);
+        for (int v = 1; v < 4; ++v) col[e][v] = _mm_add_epi64(col[e][v - 1], two);
+      }
+      for (int k = 0; k < spp; ++k) {
+        const int64_t r0 = row0 + smallOffsets[0][k], r1 = row1 + smallOffsets[1][k],
+                      r2 = row2 + smallOffsets[2][k];
+        const uint64_t m = (w <= 4 ? smallRows<2>(col, r0, r1, r2, stepY0, stepY1, stepY2, h)
+                                   : smallRows<4>(col, r0, r1, r2, stepY0, stepY1, stepY2, h)) &
+                           columns;
+        smallMasks[k] = m;
+        any |= m;
+      }
+#else
       for (int k = 0; k < spp; ++k) smallMasks[k] = 0;
-      for (int j = 0; j < h; ++j)
+      for (int j = 0; j < h; ++j) {
+        int64_t e0 = row0, e1 = row1, e2 = row2;
         for (int i = 0; i < w; ++i) {
-          const int64_t X = int64_t(r.x0 + i) * U, Y = int64_t(r.y0 + j) * U;
-          const int64_t e0 = t.edge[0].at(X, Y) + t.edge[0].bias;
-          const int64_t e1 = t.edge[1].at(X, Y) + t.edge[1].bias;
-          const int64_t e2 = t.edge[2].at(X, Y) + t.edge[2].bias;
           for (int k = 0; k < spp; ++k) {
-            const bool in = (e0 + smallOffsets[0][k] >= 0) & (e1 + smallOffsets[1][k] >= 0) &
-                            (e2 + smallOffsets[2][k] >= 0);
-            smallMasks[k] |= uint64_t(in) << (8 * j + i);
+            // Every one >= 0: their sign bits all clear.
+            const int64_t m =
+                (e0 + smallOffsets[0][k]) | (e1 + smallOffsets[1][k]) | (e2 + smallOffsets[2][k]);
+            smallMasks[k] |= uint64_t(~m) >> 63 << (8 * j + i);
           }
+          e0 += stepX0, e1 += stepX1, e2 += stepX2;
         }
+        row0 += stepY0, row1 += stepY1, row2 += stepY2;
+      }
       for (int k = 0; k < spp; ++k) any |= smallMasks[k];
+      (void)columns;
+#endif
       if (any == 0) continue;
-      const PixelBlock b{r.x0, r.y0, w, h};
-      const size_t hb = bounds.block(r.x0, r.y0);
-      if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
-      testMaskedSamples(r.x0, r.y0, smallMasks, hb);
+      const int bx0 = rect.x0 + (r.x0 - rect.x0) / B * B, by0 = rect.y0 + (r.y0 - rect.y0) / B * B;
+      if (bx0 + B > r.x1 && by0 + B > r.y1) {  // one block
+        const PixelBlock b{r.x0, r.y0, w, h};
+        const size_t hb = bounds.block(r.x0, r.y0);
+        if (bounds.culls(hb, [&] { return lowestKeyOver(b); })) continue;
+        testMaskedSamples(r.x0, r.y0, smallMasks, hb);
+        continue;
+      }
+      for (int by = by0; by <= r.y1; by += B)
+        for (int bx = bx0; bx <= r.x1; bx += B) {
+          const int cx0 = std::max(bx, r.x0), cy0 = std::max(by, r.y0);
+          const int cw = std::min(bx + B - 1, r.x1) - cx0 + 1, ch = std::min(by + B - 1, r.y1) - cy0 + 1;
+          // The bits of the bounds' mask within this block: its columns in
+          // each of its rows.
+          const uint64_t blockColumns = ((uint64_t(1) << cw) - 1) << (cx0 - r.x0);
+          const uint64_t rows = (ch == B ? ~uint64_t(0) : (uint64_t(1) << (8 * ch)) - 1)
+                                << (8 * (cy0 - r.y0));
+          const uint64_t select = blockColumns * 0x0101010101010101ull & rows;
+          if ((any & select) == 0) continue;
+          const PixelBlock b{cx0, cy0, cw, ch};
+          const size_t hb = bounds.block(bx, by);
+          if (bounds.culls(hb, [&] { return lowestKeyOver(b); })) continue;
+          uint64_t pieceMasks[kSmallSamples];
+          for (int k = 0; k < spp; ++k) pieceMasks[k] = smallMasks[k] & select;
+          testMaskedSamples(r.x0, r.y0, pieceMasks, hb);
+        }
       continue;
     }
     prepareOffsets(t, grid, scratch);
@@ -425,7 +531,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         const BlockClass c = classifyBlock(t, scratch, U, b, lo);
         if (c == BlockClass::Reject) continue;
         const size_t hb = bounds.block(bx, by);
-        if (bounds.culls(hb, spp, [&] { return lowestKeyOver(b); })) continue;
+        if (bounds.culls(hb, [&] { return lowestKeyOver(b); })) continue;
         uint32_t written = 0, writtenMax = 0;
         if (c == BlockClass::Accept) {
           counters->samplesTested += uint64_t(b.w) * uint64_t(b.h) * uint64_t(spp);

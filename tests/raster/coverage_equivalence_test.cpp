@@ -393,6 +393,89 @@ TEST(CoverageEquivalence, SmallTrianglePathWritesTheReferenceKeysAndWinners) {
     }
 }
 
+// The small-triangle path over several blocks (bounds within the tile of
+// at most 8 × 8 pixels and 64 samples: masks over the bounds, split per
+// block of the tile) against the reference walk, on each tile as the
+// camera pass runs it (a cleared rect: the hierarchical test's count of
+// samples left per block): grids of 3.7- and 6.1-pixel cells (bounds of
+// 4 to 8 pixels, most across a block edge or corner) with a coplanar copy
+// of part of one (exact key ties, decided by id), then random triangles
+// behind them (blocks culled once written) and tiny ones in front, at 1,
+// 2 and 4 spp, both float formats, both functions, keys only and MASK.
+RASTRAY_TEST_LABELS_OF(CoverageEquivalence, SmallTrianglesAcrossBlocksWriteTheReferenceKeysAndWinners,
+                       "quick");
+TEST(CoverageEquivalence, SmallTrianglesAcrossBlocksWriteTheReferenceKeysAndWinners) {
+  Scene scene;
+  std::mt19937 rng(29);
+  const auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  for (const double cell : {3.7, 6.1}) {
+    const int cells = int(kSize / cell) + 1;
+    std::vector<glm::vec3> p;
+    for (int y = 0; y <= cells; ++y)
+      for (int x = 0; x <= cells; ++x)
+        p.push_back(world(x * cell - 0.4, y * cell + 0.2, -1.0 - uniform(0.0, 0.05)));
+    std::vector<glm::uvec3> t = gridTriangles(cells);
+    test::addMesh(scene, p, t);
+    if (cell < 4.0) {
+      t.resize(t.size() / 3);
+      test::addMesh(scene, p, t);  // the copy: exact ties
+    }
+  }
+  const Scene behind = randomScene(31, 60);
+  test::addPushedBehind(scene, behind, -2.0f);
+  std::vector<glm::vec3> p;
+  std::vector<glm::uvec3> t;
+  for (uint32_t k = 0; k < 400; ++k) {
+    const double cx = uniform(0.0, kSize), cy = uniform(0.0, kSize);
+    for (int v = 0; v < 3; ++v) p.push_back(world(cx + uniform(-3.0, 3.0), cy + uniform(-3.0, 3.0), -0.5));
+    t.push_back({3 * k, 3 * k + 1, 3 * k + 2});
+  }
+  test::addMesh(scene, p, t);
+  const Camera ortho = test::orthoCamera(kSize, kSize / 2.0, 0.0, 10.0);
+  const Camera persp =
+      test::perspectiveCamera(kSize, kSize, 1.2, glm::dvec3(2, 3, 70), glm::dvec3(0, 0, 0), 0.5);
+  const std::function<bool(const TriangleSetup&, int, int, int)> alpha = [](const TriangleSetup& tri, int x,
+                                                                            int y, int s) {
+    return ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ uint32_t(s) ^ tri.triangle) % 5 != 0;
+  };
+  const TileGrid tiles(kSize, kSize);
+  for (const int spp : {1, 2, 4})
+    for (const Camera* camera : {&ortho, &persp}) {
+      const DepthFormat format = camera == &ortho ? DepthFormat::FloatReversed : DepthFormat::Float;
+      const SampleGrid grid = makeSampleGrid(spp, kSize, kSize);
+      const auto setups = setupScene(scene, *camera, grid, format);
+      std::vector<uint32_t> bin;
+      size_t acrossBlocks = 0;
+      for (uint32_t i = 0; i < setups.size(); ++i) {
+        bin.push_back(i);
+        const TriangleSetup& s = setups[i];
+        const int w = s.pixelMax.x - s.pixelMin.x + 1, h = s.pixelMax.y - s.pixelMin.y + 1;
+        if (w <= 8 && h <= 8 && w * h * spp <= 64 &&
+            (s.pixelMin.x / 8 != s.pixelMax.x / 8 || s.pixelMin.y / 8 != s.pixelMax.y / 8))
+          ++acrossBlocks;
+      }
+      ASSERT_GT(acrossBlocks, 40u) << "spp " << spp;
+      for (const DepthFunc func : {DepthFunc::Less, DepthFunc::LEqual})
+        for (int mode = 0; mode < 3; ++mode) {  // 0 plain, 1 keys only, 2 MASK
+          if (mode == 1 && func == DepthFunc::LEqual) continue;
+          const bool keysOnly = mode == 1;
+          PassResult fast{DepthTarget(kSize, kSize, spp, keysOnly), {}};
+          PassResult slow{DepthTarget(kSize, kSize, spp, keysOnly), {}};
+          for (int tile = 0; tile < tiles.count(); ++tile) {
+            rasterDepthPass(setups, bin, grid, tiles.rect(tile), format, func, mode == 2 ? alpha : nullptr,
+                            TraceRequest{}, &fast.target, &fast.counters, CoveragePath::Fast, true);
+            rasterDepthPass(setups, bin, grid, tiles.rect(tile), format, func, mode == 2 ? alpha : nullptr,
+                            TraceRequest{}, &slow.target, &slow.counters, CoveragePath::Reference, true);
+          }
+          const std::string what = "spp " + std::to_string(spp) + " " + toString(format) + " " +
+                                   toString(func) + " mode " + std::to_string(mode);
+          ASSERT_NO_FATAL_FAILURE(expectSamePass(fast, slow, what));
+          // Blocks written whole by the grids cull the triangles behind them.
+          EXPECT_LT(fast.counters.samplesTested, slow.counters.samplesTested) << what;
+        }
+    }
+}
+
 TEST(CoverageEquivalence, RendersMatchTheReferenceWalkWithMaskAndBlend) {
   Scene scene = randomScene(21, 120);
   // Every third instance MASK with a constant alpha below the cutoff on
