@@ -25,6 +25,9 @@ namespace kernel_detail {
 // Lanes per block: a multiple of every target's float lane count (4, 8, 16),
 // so a block is whole vectors; a partial block is padded (padLanes).
 constexpr size_t kBlock = 64;
+// Lights the two-pass lanes (LanesSurfaceLights) take; more take the
+// separate passes.
+constexpr size_t kTwoPassLights = 4;
 
 // One block of lanes, struct of arrays. Filled by the host (gather), read
 // and written by the lane functions.
@@ -72,6 +75,10 @@ struct LaneBlock {
   // Per light, refilled for each light: light − position (the vector to the
   // light) in double, rounded.
   alignas(64) float toLightX[kBlock], toLightY[kBlock], toLightZ[kBlock];
+  // The same for each of the first kTwoPassLights lights at once
+  // (LanesSurfaceLights).
+  alignas(64) float lightX[kTwoPassLights][kBlock], lightY[kTwoPassLights][kBlock],
+      lightZ[kTwoPassLights][kBlock];
   // Per light: E·cosθ where the light reaches the lane (else 0), then the
   // host's transmittance V per channel.
   alignas(64) float weight[kBlock];
@@ -93,6 +100,17 @@ struct LaneLight {
   float cosOuter;             // spot: t = (cd − cosOuter) / coneDenominator
   float coneDenominator;      // max(1e-6, cos inner − cos outer)
   float dirX, dirY, dirZ;     // directional: unit, towards the light
+  double posX, posY, posZ;    // point, spot: the light's position (LanesToLight's operand)
+};
+
+// Where the two-pass lanes (LanesSurfaceLights, LanesLightsFinish) read each lane's inputs: the
+// block's own arrays, or a PrimaryHitBlock's in place. Every array holds
+// the block's `lanes` entries (padding included).
+struct LaneInputs {
+  const int32_t* run;    // per lane: its entry in the block's run tables
+  const int64_t* run64;  // the same, for double lanes
+  const double *dirX, *dirY, *dirZ;
+  const float *b1, *b2;
 };
 
 // Batched refinement (primary_refinement.h): one block of lanes in double.
@@ -121,6 +139,7 @@ namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 using kernel_detail::LaneBlock;
 using kernel_detail::LaneLight;
+using kernel_detail::LaneInputs;
 
 // Lanes per vector of the running target.
 size_t KernelLanes() { return hn::Lanes(hn::ScalableTag<float>()); }
@@ -319,6 +338,146 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   }
 }
 
+// The lanes above in two passes instead of five, for a block whose lights
+// need no visibility callback (the eye light, or no LightVisibility): each
+// lane's operations the same and in the same order (the same bits), with
+// fewer intermediates through the block's arrays. The double pass
+// (LanesSurfaceLights) is LanesSurface, with each lane's position kept in
+// registers for LanesToLight of every point or spot light; the float pass
+// (LanesLightsFinish) is LanesNormals, then per light LanesLightWeight and
+// LanesAccumulate (V = 1), then LanesFinish.
+void LanesSurfaceLights(LaneBlock* b, const LaneInputs* in, const LaneLight* lights, size_t lightCount,
+                        bool eyeLight) {
+  const hn::ScalableTag<double> d;
+  const hn::Rebind<float, decltype(d)> df;
+  const size_t N = hn::Lanes(d);
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0), minusOne = hn::Set(d, -1.0);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const RunLanes<decltype(d)> get(d, in->run64, i);
+    const auto dx = hn::Load(d, in->dirX + i), dy = hn::Load(d, in->dirY + i), dz = hn::Load(d, in->dirZ + i);
+    const auto dot =
+        hn::Add(hn::Add(hn::Mul(dx, get(b->ngXd)), hn::Mul(dy, get(b->ngYd))), hn::Mul(dz, get(b->ngZd)));
+    hn::Store(hn::DemoteTo(df, hn::IfThenElse(hn::Lt(dot, zero), one, minusOne)), df, b->side + i);
+    hn::Store(hn::DemoteTo(df, dx), df, b->dirX + i);
+    hn::Store(hn::DemoteTo(df, dy), df, b->dirY + i);
+    hn::Store(hn::DemoteTo(df, dz), df, b->dirZ + i);
+    const auto b1 = hn::PromoteTo(d, hn::Load(df, in->b1 + i)), b2 = hn::PromoteTo(d, hn::Load(df, in->b2 + i));
+    const auto b0 = hn::Sub(hn::Sub(one, b1), b2);
+    hn::Store(hn::DemoteTo(df, b0), df, b->b0 + i);
+    if (eyeLight) continue;
+    const auto corner = [&](const double* p0, const double* p1, const double* p2) {
+      return hn::Add(hn::Add(hn::Mul(b0, get(p0)), hn::Mul(b1, get(p1))), hn::Mul(b2, get(p2)));
+    };
+    const auto posX = corner(b->p0X, b->p1X, b->p2X);
+    const auto posY = corner(b->p0Y, b->p1Y, b->p2Y);
+    const auto posZ = corner(b->p0Z, b->p1Z, b->p2Z);
+    for (size_t l = 0; l < lightCount; ++l) {
+      if (lights[l].type == 2) continue;
+      hn::Store(hn::DemoteTo(df, hn::Sub(hn::Set(d, lights[l].posX), posX)), df, b->lightX[l] + i);
+      hn::Store(hn::DemoteTo(df, hn::Sub(hn::Set(d, lights[l].posY), posY)), df, b->lightY[l] + i);
+      hn::Store(hn::DemoteTo(df, hn::Sub(hn::Set(d, lights[l].posZ), posZ)), df, b->lightZ[l] + i);
+    }
+  }
+}
+
+void LanesLightsFinish(LaneBlock* b, const LaneInputs* in, const LaneLight* lights, size_t lightCount,
+                       bool eyeLight) {
+  const hn::ScalableTag<float> df;
+  const size_t N = hn::Lanes(df);
+  const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const auto inf = hn::Set(df, std::numeric_limits<float>::infinity());
+  const auto invPi = hn::Set(df, eyeLight ? 1.0f : float(0.31830988618379067154));
+  const bool perLane = b->colourPerLane;
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const RunLanes<decltype(df)> get(df, in->run, i);
+    // LanesNormals.
+    const auto b0f = hn::Load(df, b->b0 + i), b1f = hn::Load(df, in->b1 + i), b2f = hn::Load(df, in->b2 + i);
+    const auto sx =
+        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0X)), hn::Mul(b1f, get(b->n1X))), hn::Mul(b2f, get(b->n2X)));
+    const auto sy =
+        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0Y)), hn::Mul(b1f, get(b->n1Y))), hn::Mul(b2f, get(b->n2Y)));
+    const auto sz =
+        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0Z)), hn::Mul(b1f, get(b->n1Z))), hn::Mul(b2f, get(b->n2Z)));
+    const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(sx, sx), hn::Mul(sy, sy)), hn::Mul(sz, sz)));
+    const auto gx = get(b->ngX), gy = get(b->ngY), gz = get(b->ngZ);
+    const auto useAuthored =
+        hn::And(hn::Gt(get(b->authored), zero), hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
+    const auto side = hn::Load(df, b->side + i);
+    const auto fx = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sx, length), gx));
+    const auto fy = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sy, length), gy));
+    const auto fz = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sz, length), gz));
+    const auto dx = hn::Load(df, b->dirX + i), dy = hn::Load(df, b->dirY + i), dz = hn::Load(df, b->dirZ + i);
+    const auto facingDot = hn::Add(hn::Add(hn::Mul(fx, dx), hn::Mul(fy, dy)), hn::Mul(fz, dz));
+    const auto faces = hn::Lt(facingDot, zero);
+    const auto nx = hn::IfThenElse(faces, fx, hn::Mul(side, gx));
+    const auto ny = hn::IfThenElse(faces, fy, hn::Mul(side, gy));
+    const auto nz = hn::IfThenElse(faces, fz, hn::Mul(side, gz));
+    hn::Vec<decltype(df)> sumR, sumG, sumB;
+    if (eyeLight) {
+      const auto cosine = hn::Abs(hn::Add(hn::Add(hn::Mul(nx, dx), hn::Mul(ny, dy)), hn::Mul(nz, dz)));
+      sumR = sumG = sumB = cosine;
+    } else {
+      sumR = sumG = sumB = zero;
+      for (size_t l = 0; l < lightCount; ++l) {
+        const LaneLight& light = lights[l];
+        // LanesLightWeight.
+        auto lx = hn::Set(df, light.dirX), ly = hn::Set(df, light.dirY), lz = hn::Set(df, light.dirZ);
+        auto irradiance = hn::Set(df, light.intensity);
+        auto reaches = hn::Eq(zero, zero);
+        if (light.type != 2) {
+          const auto vx = hn::Load(df, b->lightX[l] + i), vy = hn::Load(df, b->lightY[l] + i),
+                     vz = hn::Load(df, b->lightZ[l] + i);
+          const auto distance = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), hn::Mul(vz, vz)));
+          reaches = hn::Gt(distance, zero);
+          lx = hn::Div(vx, distance);
+          ly = hn::Div(vy, distance);
+          lz = hn::Div(vz, distance);
+          irradiance = hn::Div(hn::Div(irradiance, distance), distance);
+          if (light.range > 0.0f) {
+            const auto r = hn::Div(distance, hn::Set(df, light.range));
+            const auto r2 = hn::Mul(r, r);
+            irradiance = hn::Mul(irradiance, hn::Min(hn::Max(hn::Sub(one, hn::Mul(r2, r2)), zero), one));
+          }
+          if (light.type == 1) {
+            const auto cd = hn::Neg(hn::Add(
+                hn::Add(hn::Mul(hn::Set(df, light.spotX), lx), hn::Mul(hn::Set(df, light.spotY), ly)),
+                hn::Mul(hn::Set(df, light.spotZ), lz)));
+            const auto t = hn::Min(
+                hn::Max(hn::Div(hn::Sub(cd, hn::Set(df, light.cosOuter)), hn::Set(df, light.coneDenominator)),
+                        zero),
+                one);
+            irradiance = hn::Mul(irradiance, hn::Mul(t, t));
+          }
+        }
+        const auto cosine = hn::Add(hn::Add(hn::Mul(nx, lx), hn::Mul(ny, ly)), hn::Mul(nz, lz));
+        reaches = hn::And(reaches, hn::And(hn::Gt(cosine, zero), hn::Gt(irradiance, zero)));
+        const auto w = hn::IfThenElseZero(reaches, hn::Mul(irradiance, cosine));
+        // LanesAccumulate without visibility.
+        const auto lit = hn::Gt(w, zero);
+        sumR = hn::Add(sumR, hn::IfThenElseZero(lit, hn::Mul(hn::Set(df, light.colorR), w)));
+        sumG = hn::Add(sumG, hn::IfThenElseZero(lit, hn::Mul(hn::Set(df, light.colorG), w)));
+        sumB = hn::Add(sumB, hn::IfThenElseZero(lit, hn::Mul(hn::Set(df, light.colorB), w)));
+      }
+    }
+    // LanesFinish.
+    const auto diffuse = get(b->diffuseWeight);
+    const auto hasDiffuse = hn::Gt(diffuse, zero);
+    const auto read = [&](const float* lane, const float* run) {
+      return perLane ? hn::Load(df, lane + i) : get(run);
+    };
+    const auto alpha = read(b->alpha, b->runAlpha);
+    const auto channel = [&](const auto& albedo, const auto& sum, const auto& e, float* out) {
+      const auto direct = hn::Mul(albedo, hn::Mul(sum, invPi));
+      const auto L = hn::IfThenElse(hasDiffuse, hn::Add(e, hn::Mul(diffuse, direct)), e);
+      hn::Store(hn::Mul(L, alpha), df, out + i);
+    };
+    channel(read(b->albedoR, b->runAlbedoR), sumR, read(b->emitR, b->runEmitR), b->outR);
+    channel(read(b->albedoG, b->runAlbedoG), sumG, read(b->emitG, b->runEmitG), b->outG);
+    channel(read(b->albedoB, b->runAlbedoB), sumB, read(b->emitB, b->runEmitB), b->outB);
+    hn::Store(alpha, df, b->outA + i);
+  }
+}
+
 // Lanes [i0, i0 + n) of the block from one run of a PrimaryHitBlock:
 // run index r, the hits' directions and barycentrics (BlockShader::addRun).
 void LanesAppendRun(LaneBlock* b, size_t i0, size_t n, int32_t r, const double* dirX, const double* dirY,
@@ -408,6 +567,7 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -429,6 +589,8 @@ HWY_EXPORT(LanesNormals);
 HWY_EXPORT(LanesLightWeight);
 HWY_EXPORT(LanesAccumulate);
 HWY_EXPORT(LanesFinish);
+HWY_EXPORT(LanesSurfaceLights);
+HWY_EXPORT(LanesLightsFinish);
 HWY_EXPORT(LanesAppendRun);
 HWY_EXPORT(LanesStoreColors);
 HWY_EXPORT(RefineLanes);
@@ -437,6 +599,7 @@ HWY_EXPORT(LanesRefine);
 using kernel_detail::kBlock;
 using kernel_detail::LaneBlock;
 using kernel_detail::LaneLight;
+using kernel_detail::LaneInputs;
 
 ShadeHit refinePrimaryHit(const Scene& scene, const Ray& ray, const SampleHit& hit,
                           const glm::dvec2& footprintPosition) {
@@ -457,6 +620,14 @@ ShadeHit refinePrimaryHit(const Scene& scene, const Ray& ray, const SampleHit& h
   }
   return s;
 }
+
+namespace {
+
+std::atomic<bool> twoPassShading{true};
+
+}  // namespace
+
+void setTwoPassShadingForTest(bool enabled) { twoPassShading.store(enabled, std::memory_order_relaxed); }
 
 namespace {
 
@@ -508,6 +679,9 @@ LaneLight laneLight(const Light& light) {
   l.dirX = float(-light.direction.x);
   l.dirY = float(-light.direction.y);
   l.dirZ = float(-light.direction.z);
+  l.posX = light.position.x;
+  l.posY = light.position.y;
+  l.posZ = light.position.z;
   return l;
 }
 
@@ -518,6 +692,7 @@ class BlockShader {
       : shader_(shader),
         scene_(shader.scene()),
         vectorLanes_(HWY_DYNAMIC_DISPATCH(KernelLanes)()),
+        twoPass_(twoPassShading.load(std::memory_order_relaxed)),
         visible_(shader.visibility() && !shader.eyeLight() && !shader.scene().lights.empty()) {
     for (const Light& light : scene_.lights) lights_.push_back(laneLight(light));
     std::fill_n(runKeys_, size_t(1) << kRunCacheBits, ~uint64_t(0));
@@ -661,8 +836,17 @@ class BlockShader {
   void run() {
     LaneBlock& b = block_;
     if (b.used == 0) return;
-    padLanes();
     const bool eyeLight = shader_.eyeLight();
+    padLanes(vectorLanes_);
+    if (twoPass_ && (eyeLight || (!shader_.visibility() && lights_.size() <= kernel_detail::kTwoPassLights))) {
+      // No visibility callback between the lights' weights and their
+      // sums: the steps in two passes over the lanes.
+      const LaneInputs in{b.run, b.run64, b.dirXd, b.dirYd, b.dirZd, b.b1, b.b2};
+      HWY_DYNAMIC_DISPATCH(LanesSurfaceLights)(&b, &in, lights_.data(), lights_.size(), eyeLight);
+      HWY_DYNAMIC_DISPATCH(LanesLightsFinish)(&b, &in, lights_.data(), lights_.size(), eyeLight);
+      storeColors();
+      return;
+    }
     HWY_DYNAMIC_DISPATCH(LanesSurface)(&b, !eyeLight);
     HWY_DYNAMIC_DISPATCH(LanesNormals)(&b, eyeLight);
     if (!eyeLight) {
@@ -704,6 +888,13 @@ class BlockShader {
       }
     }
     HWY_DYNAMIC_DISPATCH(LanesFinish)(&b, eyeLight);
+    storeColors();
+  }
+
+ private:
+  // The block's colours to their outputs; empties the block.
+  void storeColors() {
+    LaneBlock& b = block_;
     if (contiguous_) {
       // The lanes' colours go to consecutive pixels (a run of samples
       // along a tile row): written interleaved in lanes.
@@ -718,7 +909,6 @@ class BlockShader {
     b.colourPerLane = false;
   }
 
- private:
   // What every lane on one triangle reads: its instance, corner indices,
   // positions (double, exact), face normal (double and rounded) and
   // authored corner normals (zero when the instance has none).
@@ -829,9 +1019,9 @@ class BlockShader {
   // Fills the lanes from `used` to a whole number of vectors with a
   // harmless surface (the last run's normals and corners at b0 = 1, no
   // colour), never read back.
-  void padLanes() {
+  void padLanes(size_t vectorLanes) {
     LaneBlock& b = block_;
-    b.lanes = (b.used + vectorLanes_ - 1) / vectorLanes_ * vectorLanes_;
+    b.lanes = (b.used + vectorLanes - 1) / vectorLanes * vectorLanes;
     for (size_t i = b.used; i < b.lanes; ++i) {
       b.dirXd[i] = b.dirYd[i] = 0.0;
       b.dirZd[i] = -1.0;
@@ -848,6 +1038,7 @@ class BlockShader {
   const Shader& shader_;
   const Scene& scene_;
   const size_t vectorLanes_;
+  const bool twoPass_;  // the two-pass lanes where the lights allow it (setTwoPassShadingForTest)
   const bool visible_;  // lights with a visibility callback: lanes need their full surface point
   const Material* material_ = nullptr;  // the last lane's, and whether it samples a texture
   bool textured_ = false;

@@ -165,6 +165,12 @@ class PrimaryHitShader {
   std::unique_ptr<Impl> impl_;
 };
 
+// Tests only: whether kernels built from now on shade a block whose lights
+// need no visibility callback (at most four lights, or the eye light) in
+// two passes over its lanes (the default), or in the lanes' separate
+// passes per step (their reference: the same bits, tested).
+void setTwoPassShadingForTest(bool enabled);
+
 // The SIMD target HWY_DYNAMIC_DISPATCH runs the lanes on here (Highway's
 // name: AVX3, AVX2, SSE4, ...), for reports and tests.
 const char* shadingKernelTarget();

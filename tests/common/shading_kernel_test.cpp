@@ -529,5 +529,87 @@ TEST(ShadingKernel, RunCornersAndFaceNormalsGivenGiveTheKernelsOwnBits) {
   }
 }
 
+// The two-pass lanes (blocks whose lights need no visibility callback)
+// give the separate passes' bits: the eye light; point, spot and
+// directional lights with a range window; vertex colours (lanes that read
+// their own colours); authored normals (the Cornell box's); through both
+// entries (ShadeHits and blocks of runs), on every target.
+TEST(ShadingKernel, TwoPassLanesGiveTheSeparatePassesBits) {
+  Scene lit = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
+  Scene eyeLit = lit;
+  eyeLit.lights.clear();
+  Scene many = lit;
+  Light spot = many.lights.front();
+  spot.type = LightType::Spot;
+  spot.range = 4.5f;
+  spot.innerConeAngle = 0.3f;
+  spot.outerConeAngle = 0.9f;
+  spot.direction = glm::normalize(glm::dvec3(0.2, -1.0, -0.3));
+  spot.color = glm::vec3(0.9f, 0.6f, 0.3f);
+  Light sun = spot;
+  sun.type = LightType::Directional;
+  sun.direction = glm::normalize(glm::dvec3(-0.4, -0.5, -1.0));
+  many.lights.front().range = 2.5f;
+  many.lights.push_back(spot);
+  many.lights.push_back(sun);
+  many.colors.assign(many.positions.size(), glm::vec4(1.0f));
+  for (size_t v = 0; v < many.colors.size(); ++v)
+    many.colors[v] = glm::vec4(0.3f + 0.1f * float(v % 5), 0.8f - 0.05f * float(v % 7), 0.6f, 1.0f);
+  many.instances.front().hasColors = true;
+  for (const Scene* scene : {&lit, &eyeLit, &many}) {
+    SCOPED_TRACE(scene == &lit ? "light" : scene == &eyeLit ? "eye light" : "lights and vertex colours");
+    const Camera camera = makeCamera(*scene, {}, 64, 48);
+    const std::vector<ShadeHit> hits = primaryHits(*scene, camera, 1500);
+    ASSERT_GT(hits.size(), 500u);
+    const Shader shader(*scene, analyzeScene(*scene), camera, {}, nullptr, nullptr);
+    const size_t n = hits.size();
+    std::vector<int32_t> run(n);
+    std::vector<uint32_t> colorIndex(n);
+    HitColumns columns(hits);
+    for (size_t i = 0; i < n; ++i) colorIndex[i] = uint32_t(i);
+    const auto shadeBoth = [&](std::vector<glm::vec4>* viaHits, std::vector<glm::vec4>* viaBlocks) {
+      viaHits->assign(n, glm::vec4(-1.0f));
+      viaBlocks->assign(n, glm::vec4(-1.0f));
+      shadePrimaryHits(shader, hits.data(), n, viaHits->data(), ShadingPath::Kernel);
+      PrimaryHitShader kernel(shader, ShadingPath::Kernel);
+      std::vector<uint32_t> runInstance, runTriangle;
+      for (size_t first = 0; first < n; first += kPrimaryHitBlock) {
+        const size_t count = std::min(kPrimaryHitBlock, n - first);
+        runInstance.clear(), runTriangle.clear();
+        for (size_t k = 0; k < count; ++k) {
+          const ShadeHit& h = hits[first + k];
+          if (k == 0 || h.instance != runInstance.back() || h.triangle != runTriangle.back()) {
+            runInstance.push_back(h.instance);
+            runTriangle.push_back(h.triangle);
+          }
+          run[first + k] = int32_t(runInstance.size() - 1);
+        }
+        PrimaryHitBlock block;
+        block.count = count;
+        block.run = &run[first];
+        block.runInstance = runInstance.data();
+        block.runTriangle = runTriangle.data();
+        columns.into(block, first);
+        block.colorIndex = &colorIndex[first];
+        kernel.shade(block, viaBlocks->data());
+      }
+    };
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      SCOPED_TRACE(hwy::TargetName(target));
+      hwy::SetSupportedTargetsForTest(target);
+      std::vector<glm::vec4> passesHits, passesBlocks, twoHits, twoBlocks;
+      setTwoPassShadingForTest(false);
+      shadeBoth(&passesHits, &passesBlocks);
+      setTwoPassShadingForTest(true);
+      shadeBoth(&twoHits, &twoBlocks);
+      for (size_t i = 0; i < n; ++i) {
+        ASSERT_TRUE(sameBits(twoHits[i], passesHits[i])) << "hit " << i;
+        ASSERT_TRUE(sameBits(twoBlocks[i], passesBlocks[i])) << "hit " << i;
+      }
+    }
+    hwy::SetSupportedTargetsForTest(0);
+  }
+}
+
 }  // namespace
 }  // namespace rastray
