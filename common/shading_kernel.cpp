@@ -529,6 +529,19 @@ void LanesStoreColors(const LaneBlock* b, float* out) {
   }
 }
 
+// Whether index[k] = index[0] + k (mod 2³²) for every k < n.
+bool LanesConsecutive(const uint32_t* index, size_t n) {
+  const hn::ScalableTag<uint32_t> du;
+  const size_t N = hn::Lanes(du);
+  const uint32_t first = index[0];
+  size_t k = 0;
+  for (; k + N <= n; k += N)
+    if (!hn::AllTrue(du, hn::Eq(hn::LoadU(du, index + k), hn::Iota(du, first + uint32_t(k))))) return false;
+  for (; k < n; ++k)
+    if (index[k] != first + uint32_t(k)) return false;
+  return true;
+}
+
 size_t RefineLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 // intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp})
@@ -569,6 +582,7 @@ HWY_AFTER_NAMESPACE();
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -593,6 +607,7 @@ HWY_EXPORT(LanesSurfaceLights);
 HWY_EXPORT(LanesLightsFinish);
 HWY_EXPORT(LanesAppendRun);
 HWY_EXPORT(LanesStoreColors);
+HWY_EXPORT(LanesConsecutive);
 HWY_EXPORT(RefineLanes);
 HWY_EXPORT(LanesRefine);
 
@@ -817,11 +832,73 @@ class BlockShader {
     // not stored lane by lane (base_ + lane gives them).
     const uint32_t c0 = h.colorIndex[first];
     if (i0 == 0) base_ = &colors[c0];
-    uint32_t apart = 0;  // nonzero when some output is not c0 + k
-    for (size_t k = 0; k < n; ++k) apart |= h.colorIndex[first + k] ^ (c0 + uint32_t(k));
-    if (contiguous_ && apart == 0 && &colors[c0] == base_ + i0) return;
+    if (contiguous_ && &colors[c0] == base_ + i0 && consecutive(h.colorIndex + first, n)) return;
     noLongerContiguous(i0);
     for (size_t k = 0; k < n; ++k) outputs_[i0 + k] = &colors[h.colorIndex[first + k]];
+  }
+
+  // Whether index[k] = index[0] + k for k < n.
+  static bool consecutive(const uint32_t* index, size_t n) {
+    if (n >= 16) return HWY_DYNAMIC_DISPATCH(LanesConsecutive)(index, n);
+    uint32_t apart = 0;  // nonzero when some index is not index[0] + k
+    for (size_t k = 0; k < n; ++k) apart |= index[k] ^ (index[0] + uint32_t(k));
+    return apart == 0;
+  }
+
+  // Shades the whole of `h` reading its per-hit inputs in place (no copy
+  // into the block), when the two-pass lanes take it and no lane needs
+  // anything of its own: every run on the lanes' path (no scalar-path
+  // material), no texture, vertex colours or visibility callback, and
+  // `h` offers its inputs (PrimaryHitBlock::run64, lanes, runFirst, 64-byte
+  // aligned). The block's run table then has one entry per run of `h`
+  // (the same values when two runs share a triangle), so `h`'s run
+  // indices index it. Returns false, having done nothing, otherwise.
+  bool shadeInPlace(const PrimaryHitBlock& h, glm::vec4* colors) {
+    LaneBlock& b = block_;
+    const bool eyeLight = shader_.eyeLight();
+    if (!twoPass_ || b.used != 0 || h.count == 0 || !h.run64 || !h.runFirst) return false;
+    if (!eyeLight && (shader_.visibility() || lights_.size() > kernel_detail::kTwoPassLights)) return false;
+    const size_t lanes = (h.count + vectorLanes_ - 1) / vectorLanes_ * vectorLanes_;
+    if (h.lanes < lanes || h.runs > kBlock) return false;
+    const auto aligned = [](const void* p) { return reinterpret_cast<uintptr_t>(p) % 64 == 0; };
+    if (!aligned(h.run) || !aligned(h.run64) || !aligned(h.dirX) || !aligned(h.dirY) || !aligned(h.dirZ) ||
+        !aligned(h.b1) || !aligned(h.b2))
+      return false;
+    const Material* materials[kBlock];
+    uint32_t instance = kNoId;
+    for (size_t r = 0; r < h.runs; ++r) {
+      if (h.runInstance[r] != instance) {
+        instance = h.runInstance[r];
+        const Material& m = scene_.materialOf(instance);
+        if (needsScalarShade(shader_, m) || samplesTexture(shader_, m) || scene_.instances[instance].hasColors)
+          return false;
+        materials[r] = &m;
+      } else {
+        materials[r] = materials[r - 1];
+      }
+    }
+    for (size_t r = 0; r < h.runs; ++r) {
+      if (h.runCorners && h.runFaceNormal && h.runCorners[r].x != kNoId)
+        enterRun(h.runInstance[r], h.runTriangle[r], *materials[r], &h.runCorners[r], &h.runFaceNormal[r],
+                 /*everyRun=*/true);
+      else
+        enterRun(h.runInstance[r], h.runTriangle[r], *materials[r], nullptr, nullptr, /*everyRun=*/true);
+    }
+    b.used = h.count;
+    b.lanes = lanes;
+    b.colourPerLane = false;
+    const LaneInputs in{h.run, h.run64, h.dirX, h.dirY, h.dirZ, h.b1, h.b2};
+    HWY_DYNAMIC_DISPATCH(LanesSurfaceLights)(&b, &in, lights_.data(), lights_.size(), eyeLight);
+    HWY_DYNAMIC_DISPATCH(LanesLightsFinish)(&b, &in, lights_.data(), lights_.size(), eyeLight);
+    if (consecutive(h.colorIndex, h.count)) {
+      HWY_DYNAMIC_DISPATCH(LanesStoreColors)(&b, &colors[h.colorIndex[0]].x);
+    } else {
+      for (size_t i = 0; i < b.used; ++i)
+        colors[h.colorIndex[i]] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
+    }
+    b.used = 0;
+    b.runs = 0;
+    return true;
   }
 
   // The block's outputs stop being consecutive at lane i: lanes [0, i)
@@ -930,8 +1007,9 @@ class BlockShader {
   // its neighbours).
   // With `corners` and `faceNormal` (the caller's, PrimaryHitBlock), the
   // triangle's values are made from them instead of the run cache.
+  // With `everyRun`, a new entry even on the same triangle.
   void enterRun(uint32_t instance, uint32_t triangle, const Material& m, const glm::uvec3* corners = nullptr,
-                const glm::dvec3* faceNormal = nullptr) {
+                const glm::dvec3* faceNormal = nullptr, bool everyRun = false) {
     LaneBlock& b = block_;
     const bool newTriangle = instance != run_.instance || triangle != run_.triangle;
     if (newTriangle) {
@@ -940,7 +1018,7 @@ class BlockShader {
       else
         startRun(instance, triangle);
     }
-    if (!newTriangle && b.runs != 0) return;
+    if (!newTriangle && b.runs != 0 && !everyRun) return;
     const size_t r = b.runs++;
     b.ngX[r] = run_.ngF.x;
     b.ngY[r] = run_.ngF.y;
@@ -1132,6 +1210,10 @@ void PrimaryHitShader::shade(const PrimaryHitBlock& h, glm::vec4* colors) {
   if (s.reference) {
     for (size_t k = 0; k < h.count; ++k) shadeHit(k);
     return;
+  }
+  if (h.run64 && h.runFirst) {
+    if (!s.block) s.block.emplace(s.shader);
+    if (s.block->shadeInPlace(h, colors)) return;
   }
   for (size_t first = 0, end = 0; first < h.count; first = end) {
     const int32_t run = h.run[first];

@@ -421,7 +421,23 @@ void PrimaryBatch::run() {
 PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footprintY,
                                    const uint32_t* colorIndex) {
   runFirst_[runs_] = uint32_t(used_);
+  // The kernel reads the per-hit inputs in place: lanes up to a multiple
+  // of 16 (every target's float lane count divides it) hold a copy of the
+  // last hit.
+  primary_detail::FusedBlock& b = *block_;
+  const size_t lanes = std::min(primary_detail::kBlock, (used_ + 15) / 16 * 16);
+  if (used_ > 0) {
+    const size_t last = used_ - 1;
+    for (size_t k = used_; k < lanes; ++k) {
+      b.run[k] = b.run[last];
+      b.run32[k] = b.run32[last];
+      b.dirX[k] = b.dirX[last], b.dirY[k] = b.dirY[last], b.dirZ[k] = b.dirZ[last];
+      b.kb1[k] = b.kb1[last], b.kb2[k] = b.kb2[last];
+    }
+  }
   PrimaryHitBlock h;
+  h.run64 = b.run;
+  h.lanes = lanes;
   h.runs = runs_;
   h.runFirst = runFirst_;
   h.count = used_;
