@@ -71,7 +71,12 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     hn::Store(dirX, d, b->dirX + i);
     hn::Store(dirY, d, b->dirY + i);
     hn::Store(dirZ, d, b->dirZ + i);
-
+  }
+  // The refinement in a second loop over the block: each loop's chain of
+  // divisions is shorter, so more vectors are in flight at once.
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const RunLanes<decltype(d)> get(d, b->run, i);
+    const auto dirX = hn::Load(d, b->dirX + i), dirY = hn::Load(d, b->dirY + i), dirZ = hn::Load(d, b->dirZ + i);
     RefinePlaneLanes<hn::Vec<decltype(d)>> pl;
     pl.e1x = get(b->e1x), pl.e1y = get(b->e1y), pl.e1z = get(b->e1z);
     pl.e2x = get(b->e2x), pl.e2y = get(b->e2y), pl.e2z = get(b->e2z);
@@ -89,6 +94,12 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     const auto ok = RefineOnPlane(d, dirX, dirY, dirZ, one, pl, &rb1, &rb2);
     // The interpolated barycentrics (a division) only where they are read.
     if (b->wantInterpolated || !hn::AllTrue(d, ok)) {
+      const auto x = hn::Load(d, b->x + i), y = hn::Load(d, b->y + i);
+      const auto ox = hn::Sub(x, get(b->x0)), oy = hn::Sub(y, get(b->y0));
+      const auto plane = [&](const double* v0, const double* dx, const double* dy) {
+        return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox)), hn::Mul(get(dy), oy));
+      };
+      const auto invW = plane(b->iw0, b->iwx, b->iwy);
       const auto inv = hn::Div(one, invW);
       const auto b1 = hn::Mul(plane(b->b10, b->b1x, b->b1y), inv);
       const auto b2 = hn::Mul(plane(b->b20, b->b2x, b->b2y), inv);
