@@ -138,8 +138,8 @@ namespace rastray {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 using kernel_detail::LaneBlock;
-using kernel_detail::LaneLight;
 using kernel_detail::LaneInputs;
+using kernel_detail::LaneLight;
 
 // Lanes per vector of the running target.
 size_t KernelLanes() { return hn::Lanes(hn::ScalableTag<float>()); }
@@ -361,11 +361,12 @@ void LanesSurfaceLights(LaneBlock* b, const LaneInputs* in, const LaneLight* lig
     hn::Store(hn::DemoteTo(df, dx), df, b->dirX + i);
     hn::Store(hn::DemoteTo(df, dy), df, b->dirY + i);
     hn::Store(hn::DemoteTo(df, dz), df, b->dirZ + i);
-    const auto b1 = hn::PromoteTo(d, hn::Load(df, in->b1 + i)), b2 = hn::PromoteTo(d, hn::Load(df, in->b2 + i));
+    const auto b1 = hn::PromoteTo(d, hn::Load(df, in->b1 + i)),
+               b2 = hn::PromoteTo(d, hn::Load(df, in->b2 + i));
     const auto b0 = hn::Sub(hn::Sub(one, b1), b2);
     hn::Store(hn::DemoteTo(df, b0), df, b->b0 + i);
     if (eyeLight) continue;
-    const auto corner = [&](const double* p0, const double* p1, const double* p2) {
+    const auto corner = [&](const double* p0, const double* p1, const double* p2) RASTRAY_LAMBDA_INLINE {
       return hn::Add(hn::Add(hn::Mul(b0, get(p0)), hn::Mul(b1, get(p1))), hn::Mul(b2, get(p2)));
     };
     const auto posX = corner(b->p0X, b->p1X, b->p2X);
@@ -439,9 +440,9 @@ void LanesLightsFinish(LaneBlock* b, const LaneInputs* in, const LaneLight* ligh
             irradiance = hn::Mul(irradiance, hn::Min(hn::Max(hn::Sub(one, hn::Mul(r2, r2)), zero), one));
           }
           if (light.type == 1) {
-            const auto cd = hn::Neg(hn::Add(
-                hn::Add(hn::Mul(hn::Set(df, light.spotX), lx), hn::Mul(hn::Set(df, light.spotY), ly)),
-                hn::Mul(hn::Set(df, light.spotZ), lz)));
+            const auto cd = hn::Neg(
+                hn::Add(hn::Add(hn::Mul(hn::Set(df, light.spotX), lx), hn::Mul(hn::Set(df, light.spotY), ly)),
+                        hn::Mul(hn::Set(df, light.spotZ), lz)));
             const auto t = hn::Min(
                 hn::Max(hn::Div(hn::Sub(cd, hn::Set(df, light.cosOuter)), hn::Set(df, light.coneDenominator)),
                         zero),
@@ -613,8 +614,8 @@ HWY_EXPORT(LanesRefine);
 
 using kernel_detail::kBlock;
 using kernel_detail::LaneBlock;
-using kernel_detail::LaneLight;
 using kernel_detail::LaneInputs;
+using kernel_detail::LaneLight;
 
 ShadeHit refinePrimaryHit(const Scene& scene, const Ray& ray, const SampleHit& hit,
                           const glm::dvec2& footprintPosition) {
@@ -870,7 +871,8 @@ class BlockShader {
       if (h.runInstance[r] != instance) {
         instance = h.runInstance[r];
         const Material& m = scene_.materialOf(instance);
-        if (needsScalarShade(shader_, m) || samplesTexture(shader_, m) || scene_.instances[instance].hasColors)
+        if (needsScalarShade(shader_, m) || samplesTexture(shader_, m) ||
+            scene_.instances[instance].hasColors)
           return false;
         materials[r] = &m;
       } else {
@@ -915,7 +917,8 @@ class BlockShader {
     if (b.used == 0) return;
     const bool eyeLight = shader_.eyeLight();
     padLanes(vectorLanes_);
-    if (twoPass_ && (eyeLight || (!shader_.visibility() && lights_.size() <= kernel_detail::kTwoPassLights))) {
+    if (twoPass_ &&
+        (eyeLight || (!shader_.visibility() && lights_.size() <= kernel_detail::kTwoPassLights))) {
       // No visibility callback between the lights' weights and their
       // sums: the steps in two passes over the lanes.
       const LaneInputs in{b.run, b.run64, b.dirXd, b.dirYd, b.dirZd, b.b1, b.b2};

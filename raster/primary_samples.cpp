@@ -46,7 +46,7 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     const RunLanes<decltype(d)> get(d, b->run, i);  // per-run values: a broadcast or a gather
     const auto x = hn::Load(d, b->x + i), y = hn::Load(d, b->y + i);
     const auto ox = hn::Sub(x, get(b->x0)), oy = hn::Sub(y, get(b->y0));
-    const auto plane = [&](const double* v0, const double* dx, const double* dy) {
+    const auto plane = [&](const double* v0, const double* dx, const double* dy) RASTRAY_LAMBDA_INLINE {
       return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox)), hn::Mul(get(dy), oy));
     };
     const auto invW = plane(b->iw0, b->iwx, b->iwy);
@@ -76,7 +76,8 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
   // divisions is shorter, so more vectors are in flight at once.
   for (size_t i = 0; i < b->lanes; i += N) {
     const RunLanes<decltype(d)> get(d, b->run, i);
-    const auto dirX = hn::Load(d, b->dirX + i), dirY = hn::Load(d, b->dirY + i), dirZ = hn::Load(d, b->dirZ + i);
+    const auto dirX = hn::Load(d, b->dirX + i), dirY = hn::Load(d, b->dirY + i),
+               dirZ = hn::Load(d, b->dirZ + i);
     RefinePlaneLanes<hn::Vec<decltype(d)>> pl;
     pl.e1x = get(b->e1x), pl.e1y = get(b->e1y), pl.e1z = get(b->e1z);
     pl.e2x = get(b->e2x), pl.e2y = get(b->e2y), pl.e2z = get(b->e2z);
@@ -96,7 +97,7 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     if (b->wantInterpolated || !hn::AllTrue(d, ok)) {
       const auto x = hn::Load(d, b->x + i), y = hn::Load(d, b->y + i);
       const auto ox = hn::Sub(x, get(b->x0)), oy = hn::Sub(y, get(b->y0));
-      const auto plane = [&](const double* v0, const double* dx, const double* dy) {
+      const auto plane = [&](const double* v0, const double* dx, const double* dy) RASTRAY_LAMBDA_INLINE {
         return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox)), hn::Mul(get(dy), oy));
       };
       const auto invW = plane(b->iw0, b->iwx, b->iwy);
