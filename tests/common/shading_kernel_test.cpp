@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -533,7 +534,8 @@ TEST(ShadingKernel, RunCornersAndFaceNormalsGivenGiveTheKernelsOwnBits) {
 // give the separate passes' bits: the eye light; point, spot and
 // directional lights with a range window; vertex colours (lanes that read
 // their own colours); authored normals (the Cornell box's); through both
-// entries (ShadeHits and blocks of runs), on every target.
+// entries (ShadeHits and blocks of runs) and blocks read in place (the
+// fused pass's), on every target.
 TEST(ShadingKernel, TwoPassLanesGiveTheSeparatePassesBits) {
   Scene lit = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
   Scene eyeLit = lit;
@@ -594,6 +596,55 @@ TEST(ShadingKernel, TwoPassLanesGiveTheSeparatePassesBits) {
         kernel.shade(block, viaBlocks->data());
       }
     };
+    // Blocks whose inputs the kernel reads in place (run64, lanes, runFirst,
+    // 64-byte aligned, padded with the last hit: the fused pass's block),
+    // colours to consecutive entries or scattered (reversed).
+    struct alignas(64) InPlace {
+      alignas(64) int32_t run[kPrimaryHitBlock];
+      alignas(64) int64_t run64[kPrimaryHitBlock];
+      alignas(64) double dx[kPrimaryHitBlock], dy[kPrimaryHitBlock], dz[kPrimaryHitBlock];
+      alignas(64) float b1[kPrimaryHitBlock], b2[kPrimaryHitBlock];
+    };
+    const auto shadeInPlace = [&](bool scattered) {
+      std::vector<glm::vec4> got(n, glm::vec4(-1.0f));
+      PrimaryHitShader kernel(shader, ShadingPath::Kernel);
+      auto in = std::make_unique<InPlace>();
+      std::vector<uint32_t> runInstance, runTriangle, runFirst, out(kPrimaryHitBlock);
+      for (size_t first = 0; first < n; first += kPrimaryHitBlock) {
+        const size_t count = std::min(kPrimaryHitBlock, n - first);
+        runInstance.clear(), runTriangle.clear(), runFirst.clear();
+        for (size_t k = 0; k < kPrimaryHitBlock; ++k) {
+          const ShadeHit& h = hits[first + std::min(k, count - 1)];  // padding: the last hit
+          if (k < count && (k == 0 || h.instance != runInstance.back() || h.triangle != runTriangle.back())) {
+            runInstance.push_back(h.instance);
+            runTriangle.push_back(h.triangle);
+            runFirst.push_back(uint32_t(k));
+          }
+          in->run[k] = int32_t(runInstance.size() - 1);
+          in->run64[k] = int64_t(runInstance.size() - 1);
+          in->dx[k] = h.direction.x, in->dy[k] = h.direction.y, in->dz[k] = h.direction.z;
+          in->b1[k] = h.b1, in->b2[k] = h.b2;
+          out[k] = uint32_t(scattered ? n - 1 - (first + k) : first + k);
+        }
+        runFirst.push_back(uint32_t(count));
+        PrimaryHitBlock block;
+        block.count = count;
+        block.run = in->run;
+        block.run64 = in->run64;
+        block.lanes = kPrimaryHitBlock;
+        block.runs = runInstance.size();
+        block.runFirst = runFirst.data();
+        block.runInstance = runInstance.data();
+        block.runTriangle = runTriangle.data();
+        block.dirX = in->dx, block.dirY = in->dy, block.dirZ = in->dz;
+        block.b1 = in->b1, block.b2 = in->b2;
+        block.footprintX = &columns.fx[first], block.footprintY = &columns.fy[first];
+        block.colorIndex = out.data();
+        kernel.shade(block, got.data());
+      }
+      if (scattered) std::reverse(got.begin(), got.end());
+      return got;
+    };
     for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
       SCOPED_TRACE(hwy::TargetName(target));
       hwy::SetSupportedTargetsForTest(target);
@@ -602,9 +653,12 @@ TEST(ShadingKernel, TwoPassLanesGiveTheSeparatePassesBits) {
       shadeBoth(&passesHits, &passesBlocks);
       setTwoPassShadingForTest(true);
       shadeBoth(&twoHits, &twoBlocks);
+      const std::vector<glm::vec4> inPlace = shadeInPlace(false), inPlaceScattered = shadeInPlace(true);
       for (size_t i = 0; i < n; ++i) {
         ASSERT_TRUE(sameBits(twoHits[i], passesHits[i])) << "hit " << i;
         ASSERT_TRUE(sameBits(twoBlocks[i], passesBlocks[i])) << "hit " << i;
+        ASSERT_TRUE(sameBits(inPlace[i], passesHits[i])) << "in place, hit " << i;
+        ASSERT_TRUE(sameBits(inPlaceScattered[i], passesHits[i])) << "in place, scattered, hit " << i;
       }
     }
     hwy::SetSupportedTargetsForTest(0);
