@@ -155,6 +155,8 @@ class PrimaryBatch {
   }
   // hit(k).depth alone (hit(k) needs wantInterpolated(true)).
   float depth(size_t k) const { return block_->depth[k]; }
+  // depth(k) for every k < size().
+  const float* depths() const { return block_->depth; }
   // Whether hit(k) is read (its interpolated barycentrics are computed);
   // true until set.
   void wantInterpolated(bool want) { block_->wantInterpolated = want; }
