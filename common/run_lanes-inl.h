@@ -19,6 +19,13 @@
 
 #include <hwy/highway.h>
 
+// A lambda in a lane function that must be inlined (GCC may leave one
+// out of line once it reads tables through RunLanes, costing a call and
+// its vectors' spills per use): `[&](...) RASTRAY_LAMBDA_INLINE { ... }`.
+#ifndef RASTRAY_LAMBDA_INLINE
+#define RASTRAY_LAMBDA_INLINE __attribute__((always_inline))
+#endif
+
 HWY_BEFORE_NAMESPACE();
 namespace rastray {
 namespace HWY_NAMESPACE {
@@ -34,23 +41,35 @@ class RunLanes {
   using T = hwy::HWY_NAMESPACE::TFromD<D>;
 
   RunLanes(D d, const Index* run, size_t i)
-      : d_(d), run_(run + i), first_(run[i]), oneRun_(first_ == run[i + hwy::HWY_NAMESPACE::Lanes(d) - 1]) {}
+      : d_(d),
+        run_(run + i),
+        first_(run[i]),
+        last_(run[i + hwy::HWY_NAMESPACE::Lanes(d) - 1]),
+        oneRun_(first_ == last_),
+        twoRuns_(last_ == first_ + 1) {
+    namespace hn = hwy::HWY_NAMESPACE;
+    if (twoRuns_) onFirst_ = hn::RebindMask(d_, hn::Eq(hn::Load(DI(), run_), hn::Set(DI(), first_)));
+  }
 
   // Whether every lane lies on one run (table reads are broadcasts).
   bool oneRun() const { return oneRun_; }
 
-  // table[run of each lane].
+  // table[run of each lane]: a broadcast on one run, two blended on two
+  // (a vector across one run's end: runs are non-decreasing, so its lanes
+  // lie on run first or first + 1), else a gather.
   HWY_INLINE hwy::HWY_NAMESPACE::Vec<D> operator()(const T* table) const {
     namespace hn = hwy::HWY_NAMESPACE;
     if (oneRun_) return hn::Set(d_, table[first_]);
+    if (twoRuns_) return hn::IfThenElse(onFirst_, hn::Set(d_, table[first_]), hn::Set(d_, table[last_]));
     return hn::GatherIndex(d_, table, hn::Load(DI(), run_));
   }
 
  private:
   D d_;
   const Index* run_;
-  Index first_;
-  bool oneRun_;
+  Index first_, last_;
+  bool oneRun_, twoRuns_;
+  hwy::HWY_NAMESPACE::Mask<D> onFirst_{};
 };
 
 }  // namespace HWY_NAMESPACE

@@ -25,6 +25,9 @@ namespace kernel_detail {
 // Lanes per block: a multiple of every target's float lane count (4, 8, 16),
 // so a block is whole vectors; a partial block is padded (padLanes).
 constexpr size_t kBlock = 64;
+// Lights the two-pass lanes (LanesSurfaceLights) take; more take the
+// separate passes.
+constexpr size_t kTwoPassLights = 4;
 
 // One block of lanes, struct of arrays. Filled by the host (gather), read
 // and written by the lane functions.
@@ -72,6 +75,10 @@ struct LaneBlock {
   // Per light, refilled for each light: light − position (the vector to the
   // light) in double, rounded.
   alignas(64) float toLightX[kBlock], toLightY[kBlock], toLightZ[kBlock];
+  // The same for each of the first kTwoPassLights lights at once
+  // (LanesSurfaceLights).
+  alignas(64) float lightX[kTwoPassLights][kBlock], lightY[kTwoPassLights][kBlock],
+      lightZ[kTwoPassLights][kBlock];
   // Per light: E·cosθ where the light reaches the lane (else 0), then the
   // host's transmittance V per channel.
   alignas(64) float weight[kBlock];
@@ -93,6 +100,17 @@ struct LaneLight {
   float cosOuter;             // spot: t = (cd − cosOuter) / coneDenominator
   float coneDenominator;      // max(1e-6, cos inner − cos outer)
   float dirX, dirY, dirZ;     // directional: unit, towards the light
+  double posX, posY, posZ;    // point, spot: the light's position (LanesToLight's operand)
+};
+
+// Where the two-pass lanes (LanesSurfaceLights, LanesLightsFinish) read each lane's inputs: the
+// block's own arrays, or a PrimaryHitBlock's in place. Every array holds
+// the block's `lanes` entries (padding included).
+struct LaneInputs {
+  const int32_t* run;    // per lane: its entry in the block's run tables
+  const int64_t* run64;  // the same, for double lanes
+  const double *dirX, *dirY, *dirZ;
+  const float *b1, *b2;
 };
 
 // Batched refinement (primary_refinement.h): one block of lanes in double.
@@ -120,6 +138,7 @@ namespace rastray {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 using kernel_detail::LaneBlock;
+using kernel_detail::LaneInputs;
 using kernel_detail::LaneLight;
 
 // Lanes per vector of the running target.
@@ -319,6 +338,147 @@ void LanesFinish(LaneBlock* b, bool eyeLight) {
   }
 }
 
+// The lanes above in two passes instead of five, for a block whose lights
+// need no visibility callback (the eye light, or no LightVisibility): each
+// lane's operations the same and in the same order (the same bits), with
+// fewer intermediates through the block's arrays. The double pass
+// (LanesSurfaceLights) is LanesSurface, with each lane's position kept in
+// registers for LanesToLight of every point or spot light; the float pass
+// (LanesLightsFinish) is LanesNormals, then per light LanesLightWeight and
+// LanesAccumulate (V = 1), then LanesFinish.
+void LanesSurfaceLights(LaneBlock* b, const LaneInputs* in, const LaneLight* lights, size_t lightCount,
+                        bool eyeLight) {
+  const hn::ScalableTag<double> d;
+  const hn::Rebind<float, decltype(d)> df;
+  const size_t N = hn::Lanes(d);
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0), minusOne = hn::Set(d, -1.0);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const RunLanes<decltype(d)> get(d, in->run64, i);
+    const auto dx = hn::Load(d, in->dirX + i), dy = hn::Load(d, in->dirY + i), dz = hn::Load(d, in->dirZ + i);
+    const auto dot =
+        hn::Add(hn::Add(hn::Mul(dx, get(b->ngXd)), hn::Mul(dy, get(b->ngYd))), hn::Mul(dz, get(b->ngZd)));
+    hn::Store(hn::DemoteTo(df, hn::IfThenElse(hn::Lt(dot, zero), one, minusOne)), df, b->side + i);
+    hn::Store(hn::DemoteTo(df, dx), df, b->dirX + i);
+    hn::Store(hn::DemoteTo(df, dy), df, b->dirY + i);
+    hn::Store(hn::DemoteTo(df, dz), df, b->dirZ + i);
+    const auto b1 = hn::PromoteTo(d, hn::Load(df, in->b1 + i)),
+               b2 = hn::PromoteTo(d, hn::Load(df, in->b2 + i));
+    const auto b0 = hn::Sub(hn::Sub(one, b1), b2);
+    hn::Store(hn::DemoteTo(df, b0), df, b->b0 + i);
+    if (eyeLight) continue;
+    const auto corner = [&](const double* p0, const double* p1, const double* p2) RASTRAY_LAMBDA_INLINE {
+      return hn::Add(hn::Add(hn::Mul(b0, get(p0)), hn::Mul(b1, get(p1))), hn::Mul(b2, get(p2)));
+    };
+    const auto posX = corner(b->p0X, b->p1X, b->p2X);
+    const auto posY = corner(b->p0Y, b->p1Y, b->p2Y);
+    const auto posZ = corner(b->p0Z, b->p1Z, b->p2Z);
+    for (size_t l = 0; l < lightCount; ++l) {
+      if (lights[l].type == 2) continue;
+      hn::Store(hn::DemoteTo(df, hn::Sub(hn::Set(d, lights[l].posX), posX)), df, b->lightX[l] + i);
+      hn::Store(hn::DemoteTo(df, hn::Sub(hn::Set(d, lights[l].posY), posY)), df, b->lightY[l] + i);
+      hn::Store(hn::DemoteTo(df, hn::Sub(hn::Set(d, lights[l].posZ), posZ)), df, b->lightZ[l] + i);
+    }
+  }
+}
+
+void LanesLightsFinish(LaneBlock* b, const LaneInputs* in, const LaneLight* lights, size_t lightCount,
+                       bool eyeLight) {
+  const hn::ScalableTag<float> df;
+  const size_t N = hn::Lanes(df);
+  const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const auto inf = hn::Set(df, std::numeric_limits<float>::infinity());
+  const auto invPi = hn::Set(df, eyeLight ? 1.0f : float(0.31830988618379067154));
+  const bool perLane = b->colourPerLane;
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const RunLanes<decltype(df)> get(df, in->run, i);
+    // LanesNormals.
+    const auto b0f = hn::Load(df, b->b0 + i), b1f = hn::Load(df, in->b1 + i), b2f = hn::Load(df, in->b2 + i);
+    const auto sx =
+        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0X)), hn::Mul(b1f, get(b->n1X))), hn::Mul(b2f, get(b->n2X)));
+    const auto sy =
+        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0Y)), hn::Mul(b1f, get(b->n1Y))), hn::Mul(b2f, get(b->n2Y)));
+    const auto sz =
+        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0Z)), hn::Mul(b1f, get(b->n1Z))), hn::Mul(b2f, get(b->n2Z)));
+    const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(sx, sx), hn::Mul(sy, sy)), hn::Mul(sz, sz)));
+    const auto gx = get(b->ngX), gy = get(b->ngY), gz = get(b->ngZ);
+    const auto useAuthored =
+        hn::And(hn::Gt(get(b->authored), zero), hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
+    const auto side = hn::Load(df, b->side + i);
+    const auto fx = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sx, length), gx));
+    const auto fy = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sy, length), gy));
+    const auto fz = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sz, length), gz));
+    const auto dx = hn::Load(df, b->dirX + i), dy = hn::Load(df, b->dirY + i), dz = hn::Load(df, b->dirZ + i);
+    const auto facingDot = hn::Add(hn::Add(hn::Mul(fx, dx), hn::Mul(fy, dy)), hn::Mul(fz, dz));
+    const auto faces = hn::Lt(facingDot, zero);
+    const auto nx = hn::IfThenElse(faces, fx, hn::Mul(side, gx));
+    const auto ny = hn::IfThenElse(faces, fy, hn::Mul(side, gy));
+    const auto nz = hn::IfThenElse(faces, fz, hn::Mul(side, gz));
+    hn::Vec<decltype(df)> sumR, sumG, sumB;
+    if (eyeLight) {
+      const auto cosine = hn::Abs(hn::Add(hn::Add(hn::Mul(nx, dx), hn::Mul(ny, dy)), hn::Mul(nz, dz)));
+      sumR = sumG = sumB = cosine;
+    } else {
+      sumR = sumG = sumB = zero;
+      for (size_t l = 0; l < lightCount; ++l) {
+        const LaneLight& light = lights[l];
+        // LanesLightWeight.
+        auto lx = hn::Set(df, light.dirX), ly = hn::Set(df, light.dirY), lz = hn::Set(df, light.dirZ);
+        auto irradiance = hn::Set(df, light.intensity);
+        auto reaches = hn::Eq(zero, zero);
+        if (light.type != 2) {
+          const auto vx = hn::Load(df, b->lightX[l] + i), vy = hn::Load(df, b->lightY[l] + i),
+                     vz = hn::Load(df, b->lightZ[l] + i);
+          const auto distance = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), hn::Mul(vz, vz)));
+          reaches = hn::Gt(distance, zero);
+          lx = hn::Div(vx, distance);
+          ly = hn::Div(vy, distance);
+          lz = hn::Div(vz, distance);
+          irradiance = hn::Div(hn::Div(irradiance, distance), distance);
+          if (light.range > 0.0f) {
+            const auto r = hn::Div(distance, hn::Set(df, light.range));
+            const auto r2 = hn::Mul(r, r);
+            irradiance = hn::Mul(irradiance, hn::Min(hn::Max(hn::Sub(one, hn::Mul(r2, r2)), zero), one));
+          }
+          if (light.type == 1) {
+            const auto cd = hn::Neg(
+                hn::Add(hn::Add(hn::Mul(hn::Set(df, light.spotX), lx), hn::Mul(hn::Set(df, light.spotY), ly)),
+                        hn::Mul(hn::Set(df, light.spotZ), lz)));
+            const auto t = hn::Min(
+                hn::Max(hn::Div(hn::Sub(cd, hn::Set(df, light.cosOuter)), hn::Set(df, light.coneDenominator)),
+                        zero),
+                one);
+            irradiance = hn::Mul(irradiance, hn::Mul(t, t));
+          }
+        }
+        const auto cosine = hn::Add(hn::Add(hn::Mul(nx, lx), hn::Mul(ny, ly)), hn::Mul(nz, lz));
+        reaches = hn::And(reaches, hn::And(hn::Gt(cosine, zero), hn::Gt(irradiance, zero)));
+        const auto w = hn::IfThenElseZero(reaches, hn::Mul(irradiance, cosine));
+        // LanesAccumulate without visibility.
+        const auto lit = hn::Gt(w, zero);
+        sumR = hn::Add(sumR, hn::IfThenElseZero(lit, hn::Mul(hn::Set(df, light.colorR), w)));
+        sumG = hn::Add(sumG, hn::IfThenElseZero(lit, hn::Mul(hn::Set(df, light.colorG), w)));
+        sumB = hn::Add(sumB, hn::IfThenElseZero(lit, hn::Mul(hn::Set(df, light.colorB), w)));
+      }
+    }
+    // LanesFinish.
+    const auto diffuse = get(b->diffuseWeight);
+    const auto hasDiffuse = hn::Gt(diffuse, zero);
+    const auto read = [&](const float* lane, const float* run) {
+      return perLane ? hn::Load(df, lane + i) : get(run);
+    };
+    const auto alpha = read(b->alpha, b->runAlpha);
+    const auto channel = [&](const auto& albedo, const auto& sum, const auto& e, float* out) {
+      const auto direct = hn::Mul(albedo, hn::Mul(sum, invPi));
+      const auto L = hn::IfThenElse(hasDiffuse, hn::Add(e, hn::Mul(diffuse, direct)), e);
+      hn::Store(hn::Mul(L, alpha), df, out + i);
+    };
+    channel(read(b->albedoR, b->runAlbedoR), sumR, read(b->emitR, b->runEmitR), b->outR);
+    channel(read(b->albedoG, b->runAlbedoG), sumG, read(b->emitG, b->runEmitG), b->outG);
+    channel(read(b->albedoB, b->runAlbedoB), sumB, read(b->emitB, b->runEmitB), b->outB);
+    hn::Store(alpha, df, b->outA + i);
+  }
+}
+
 // Lanes [i0, i0 + n) of the block from one run of a PrimaryHitBlock:
 // run index r, the hits' directions and barycentrics (BlockShader::addRun).
 void LanesAppendRun(LaneBlock* b, size_t i0, size_t n, int32_t r, const double* dirX, const double* dirY,
@@ -370,6 +530,19 @@ void LanesStoreColors(const LaneBlock* b, float* out) {
   }
 }
 
+// Whether index[k] = index[0] + k (mod 2³²) for every k < n.
+bool LanesConsecutive(const uint32_t* index, size_t n) {
+  const hn::ScalableTag<uint32_t> du;
+  const size_t N = hn::Lanes(du);
+  const uint32_t first = index[0];
+  size_t k = 0;
+  for (; k + N <= n; k += N)
+    if (!hn::AllTrue(du, hn::Eq(hn::LoadU(du, index + k), hn::Iota(du, first + uint32_t(k))))) return false;
+  for (; k < n; ++k)
+    if (index[k] != first + uint32_t(k)) return false;
+  return true;
+}
+
 size_t RefineLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 // intersectTrianglePlane then refinedBarycentrics (common/surface.{h,cpp})
@@ -408,7 +581,9 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -429,13 +604,17 @@ HWY_EXPORT(LanesNormals);
 HWY_EXPORT(LanesLightWeight);
 HWY_EXPORT(LanesAccumulate);
 HWY_EXPORT(LanesFinish);
+HWY_EXPORT(LanesSurfaceLights);
+HWY_EXPORT(LanesLightsFinish);
 HWY_EXPORT(LanesAppendRun);
 HWY_EXPORT(LanesStoreColors);
+HWY_EXPORT(LanesConsecutive);
 HWY_EXPORT(RefineLanes);
 HWY_EXPORT(LanesRefine);
 
 using kernel_detail::kBlock;
 using kernel_detail::LaneBlock;
+using kernel_detail::LaneInputs;
 using kernel_detail::LaneLight;
 
 ShadeHit refinePrimaryHit(const Scene& scene, const Ray& ray, const SampleHit& hit,
@@ -457,6 +636,14 @@ ShadeHit refinePrimaryHit(const Scene& scene, const Ray& ray, const SampleHit& h
   }
   return s;
 }
+
+namespace {
+
+std::atomic<bool> twoPassShading{true};
+
+}  // namespace
+
+void setTwoPassShadingForTest(bool enabled) { twoPassShading.store(enabled, std::memory_order_relaxed); }
 
 namespace {
 
@@ -508,6 +695,9 @@ LaneLight laneLight(const Light& light) {
   l.dirX = float(-light.direction.x);
   l.dirY = float(-light.direction.y);
   l.dirZ = float(-light.direction.z);
+  l.posX = light.position.x;
+  l.posY = light.position.y;
+  l.posZ = light.position.z;
   return l;
 }
 
@@ -518,6 +708,7 @@ class BlockShader {
       : shader_(shader),
         scene_(shader.scene()),
         vectorLanes_(HWY_DYNAMIC_DISPATCH(KernelLanes)()),
+        twoPass_(twoPassShading.load(std::memory_order_relaxed)),
         visible_(shader.visibility() && !shader.eyeLight() && !shader.scene().lights.empty()) {
     for (const Light& light : scene_.lights) lights_.push_back(laneLight(light));
     std::fill_n(runKeys_, size_t(1) << kRunCacheBits, ~uint64_t(0));
@@ -642,11 +833,74 @@ class BlockShader {
     // not stored lane by lane (base_ + lane gives them).
     const uint32_t c0 = h.colorIndex[first];
     if (i0 == 0) base_ = &colors[c0];
-    uint32_t apart = 0;  // nonzero when some output is not c0 + k
-    for (size_t k = 0; k < n; ++k) apart |= h.colorIndex[first + k] ^ (c0 + uint32_t(k));
-    if (contiguous_ && apart == 0 && &colors[c0] == base_ + i0) return;
+    if (contiguous_ && &colors[c0] == base_ + i0 && consecutive(h.colorIndex + first, n)) return;
     noLongerContiguous(i0);
     for (size_t k = 0; k < n; ++k) outputs_[i0 + k] = &colors[h.colorIndex[first + k]];
+  }
+
+  // Whether index[k] = index[0] + k for k < n.
+  static bool consecutive(const uint32_t* index, size_t n) {
+    if (n >= 16) return HWY_DYNAMIC_DISPATCH(LanesConsecutive)(index, n);
+    uint32_t apart = 0;  // nonzero when some index is not index[0] + k
+    for (size_t k = 0; k < n; ++k) apart |= index[k] ^ (index[0] + uint32_t(k));
+    return apart == 0;
+  }
+
+  // Shades the whole of `h` reading its per-hit inputs in place (no copy
+  // into the block), when the two-pass lanes take it and no lane needs
+  // anything of its own: every run on the lanes' path (no scalar-path
+  // material), no texture, vertex colours or visibility callback, and
+  // `h` offers its inputs (PrimaryHitBlock::run64, lanes, runFirst, 64-byte
+  // aligned). The block's run table then has one entry per run of `h`
+  // (the same values when two runs share a triangle), so `h`'s run
+  // indices index it. Returns false, having done nothing, otherwise.
+  bool shadeInPlace(const PrimaryHitBlock& h, glm::vec4* colors) {
+    LaneBlock& b = block_;
+    const bool eyeLight = shader_.eyeLight();
+    if (!twoPass_ || b.used != 0 || h.count == 0 || !h.run64 || !h.runFirst) return false;
+    if (!eyeLight && (shader_.visibility() || lights_.size() > kernel_detail::kTwoPassLights)) return false;
+    const size_t lanes = (h.count + vectorLanes_ - 1) / vectorLanes_ * vectorLanes_;
+    if (h.lanes < lanes || h.runs > kBlock) return false;
+    const auto aligned = [](const void* p) { return reinterpret_cast<uintptr_t>(p) % 64 == 0; };
+    if (!aligned(h.run) || !aligned(h.run64) || !aligned(h.dirX) || !aligned(h.dirY) || !aligned(h.dirZ) ||
+        !aligned(h.b1) || !aligned(h.b2))
+      return false;
+    const Material* materials[kBlock];
+    uint32_t instance = kNoId;
+    for (size_t r = 0; r < h.runs; ++r) {
+      if (h.runInstance[r] != instance) {
+        instance = h.runInstance[r];
+        const Material& m = scene_.materialOf(instance);
+        if (needsScalarShade(shader_, m) || samplesTexture(shader_, m) ||
+            scene_.instances[instance].hasColors)
+          return false;
+        materials[r] = &m;
+      } else {
+        materials[r] = materials[r - 1];
+      }
+    }
+    for (size_t r = 0; r < h.runs; ++r) {
+      if (h.runCorners && h.runFaceNormal && h.runCorners[r].x != kNoId)
+        enterRun(h.runInstance[r], h.runTriangle[r], *materials[r], &h.runCorners[r], &h.runFaceNormal[r],
+                 /*everyRun=*/true);
+      else
+        enterRun(h.runInstance[r], h.runTriangle[r], *materials[r], nullptr, nullptr, /*everyRun=*/true);
+    }
+    b.used = h.count;
+    b.lanes = lanes;
+    b.colourPerLane = false;
+    const LaneInputs in{h.run, h.run64, h.dirX, h.dirY, h.dirZ, h.b1, h.b2};
+    HWY_DYNAMIC_DISPATCH(LanesSurfaceLights)(&b, &in, lights_.data(), lights_.size(), eyeLight);
+    HWY_DYNAMIC_DISPATCH(LanesLightsFinish)(&b, &in, lights_.data(), lights_.size(), eyeLight);
+    if (consecutive(h.colorIndex, h.count)) {
+      HWY_DYNAMIC_DISPATCH(LanesStoreColors)(&b, &colors[h.colorIndex[0]].x);
+    } else {
+      for (size_t i = 0; i < b.used; ++i)
+        colors[h.colorIndex[i]] = glm::vec4(b.outR[i], b.outG[i], b.outB[i], b.outA[i]);
+    }
+    b.used = 0;
+    b.runs = 0;
+    return true;
   }
 
   // The block's outputs stop being consecutive at lane i: lanes [0, i)
@@ -661,8 +915,18 @@ class BlockShader {
   void run() {
     LaneBlock& b = block_;
     if (b.used == 0) return;
-    padLanes();
     const bool eyeLight = shader_.eyeLight();
+    padLanes(vectorLanes_);
+    if (twoPass_ &&
+        (eyeLight || (!shader_.visibility() && lights_.size() <= kernel_detail::kTwoPassLights))) {
+      // No visibility callback between the lights' weights and their
+      // sums: the steps in two passes over the lanes.
+      const LaneInputs in{b.run, b.run64, b.dirXd, b.dirYd, b.dirZd, b.b1, b.b2};
+      HWY_DYNAMIC_DISPATCH(LanesSurfaceLights)(&b, &in, lights_.data(), lights_.size(), eyeLight);
+      HWY_DYNAMIC_DISPATCH(LanesLightsFinish)(&b, &in, lights_.data(), lights_.size(), eyeLight);
+      storeColors();
+      return;
+    }
     HWY_DYNAMIC_DISPATCH(LanesSurface)(&b, !eyeLight);
     HWY_DYNAMIC_DISPATCH(LanesNormals)(&b, eyeLight);
     if (!eyeLight) {
@@ -704,6 +968,13 @@ class BlockShader {
       }
     }
     HWY_DYNAMIC_DISPATCH(LanesFinish)(&b, eyeLight);
+    storeColors();
+  }
+
+ private:
+  // The block's colours to their outputs; empties the block.
+  void storeColors() {
+    LaneBlock& b = block_;
     if (contiguous_) {
       // The lanes' colours go to consecutive pixels (a run of samples
       // along a tile row): written interleaved in lanes.
@@ -718,7 +989,6 @@ class BlockShader {
     b.colourPerLane = false;
   }
 
- private:
   // What every lane on one triangle reads: its instance, corner indices,
   // positions (double, exact), face normal (double and rounded) and
   // authored corner normals (zero when the instance has none).
@@ -740,8 +1010,9 @@ class BlockShader {
   // its neighbours).
   // With `corners` and `faceNormal` (the caller's, PrimaryHitBlock), the
   // triangle's values are made from them instead of the run cache.
+  // With `everyRun`, a new entry even on the same triangle.
   void enterRun(uint32_t instance, uint32_t triangle, const Material& m, const glm::uvec3* corners = nullptr,
-                const glm::dvec3* faceNormal = nullptr) {
+                const glm::dvec3* faceNormal = nullptr, bool everyRun = false) {
     LaneBlock& b = block_;
     const bool newTriangle = instance != run_.instance || triangle != run_.triangle;
     if (newTriangle) {
@@ -750,7 +1021,7 @@ class BlockShader {
       else
         startRun(instance, triangle);
     }
-    if (!newTriangle && b.runs != 0) return;
+    if (!newTriangle && b.runs != 0 && !everyRun) return;
     const size_t r = b.runs++;
     b.ngX[r] = run_.ngF.x;
     b.ngY[r] = run_.ngF.y;
@@ -829,9 +1100,9 @@ class BlockShader {
   // Fills the lanes from `used` to a whole number of vectors with a
   // harmless surface (the last run's normals and corners at b0 = 1, no
   // colour), never read back.
-  void padLanes() {
+  void padLanes(size_t vectorLanes) {
     LaneBlock& b = block_;
-    b.lanes = (b.used + vectorLanes_ - 1) / vectorLanes_ * vectorLanes_;
+    b.lanes = (b.used + vectorLanes - 1) / vectorLanes * vectorLanes;
     for (size_t i = b.used; i < b.lanes; ++i) {
       b.dirXd[i] = b.dirYd[i] = 0.0;
       b.dirZd[i] = -1.0;
@@ -848,6 +1119,7 @@ class BlockShader {
   const Shader& shader_;
   const Scene& scene_;
   const size_t vectorLanes_;
+  const bool twoPass_;  // the two-pass lanes where the lights allow it (setTwoPassShadingForTest)
   const bool visible_;  // lights with a visibility callback: lanes need their full surface point
   const Material* material_ = nullptr;  // the last lane's, and whether it samples a texture
   bool textured_ = false;
@@ -941,6 +1213,10 @@ void PrimaryHitShader::shade(const PrimaryHitBlock& h, glm::vec4* colors) {
   if (s.reference) {
     for (size_t k = 0; k < h.count; ++k) shadeHit(k);
     return;
+  }
+  if (h.run64 && h.runFirst) {
+    if (!s.block) s.block.emplace(s.shader);
+    if (s.block->shadeInPlace(h, colors)) return;
   }
   for (size_t first = 0, end = 0; first < h.count; first = end) {
     const int32_t run = h.run[first];

@@ -142,6 +142,14 @@ struct PrimaryHitBlock {
   // whose corners are kNoId takes the kernel's own.
   const glm::uvec3* runCorners = nullptr;
   const glm::dvec3* runFaceNormal = nullptr;
+  // Optional, so the kernel can read the per-hit inputs in place instead
+  // of copying them into its own block: each hit's run as int64 (`run`'s
+  // values), and `lanes` ≥ count such that entries [count, lanes) of run,
+  // run64, dirX/Y/Z, b1 and b2 hold a padding hit of the block's last run.
+  // Read in place only with runFirst given and those arrays and run64
+  // 64-byte aligned (the fused pass's block); else copied.
+  const int64_t* run64 = nullptr;
+  size_t lanes = 0;
 };
 
 // The kernel for blocks of hits (PrimaryHitBlock), built once per caller
@@ -164,6 +172,12 @@ class PrimaryHitShader {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// Tests only: whether kernels built from now on shade a block whose lights
+// need no visibility callback (at most four lights, or the eye light) in
+// two passes over its lanes (the default), or in the lanes' separate
+// passes per step (their reference: the same bits, tested).
+void setTwoPassShadingForTest(bool enabled);
 
 // The SIMD target HWY_DYNAMIC_DISPATCH runs the lanes on here (Highway's
 // name: AVX3, AVX2, SSE4, ...), for reports and tests.

@@ -75,7 +75,13 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     batch.run();
     const size_t count = batch.size();
     if (lean) {
-      for (size_t r = 0; r < count; ++r) samples.depth[localOut[r]] = batch.depth(r);
+      // The block's samples were added in increasing tile order, so they
+      // are consecutive when the last is count − 1 after the first (a
+      // run of a row without background): one copy.
+      if (count > 0 && localOut[count - 1] - localOut[0] == count - 1)
+        std::copy_n(batch.depths(), count, &samples.depth[localOut[0]]);
+      else
+        for (size_t r = 0; r < count; ++r) samples.depth[localOut[r]] = batch.depth(r);
     } else {
       for (size_t r = 0; r < count; ++r) samples.front[localOut[r]] = batch.hit(r);
     }

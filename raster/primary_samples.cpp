@@ -46,7 +46,7 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     const RunLanes<decltype(d)> get(d, b->run, i);  // per-run values: a broadcast or a gather
     const auto x = hn::Load(d, b->x + i), y = hn::Load(d, b->y + i);
     const auto ox = hn::Sub(x, get(b->x0)), oy = hn::Sub(y, get(b->y0));
-    const auto plane = [&](const double* v0, const double* dx, const double* dy) {
+    const auto plane = [&](const double* v0, const double* dx, const double* dy) RASTRAY_LAMBDA_INLINE {
       return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox)), hn::Mul(get(dy), oy));
     };
     const auto invW = plane(b->iw0, b->iwx, b->iwy);
@@ -71,7 +71,13 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     hn::Store(dirX, d, b->dirX + i);
     hn::Store(dirY, d, b->dirY + i);
     hn::Store(dirZ, d, b->dirZ + i);
-
+  }
+  // The refinement in a second loop over the block: each loop's chain of
+  // divisions is shorter, so more vectors are in flight at once.
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const RunLanes<decltype(d)> get(d, b->run, i);
+    const auto dirX = hn::Load(d, b->dirX + i), dirY = hn::Load(d, b->dirY + i),
+               dirZ = hn::Load(d, b->dirZ + i);
     RefinePlaneLanes<hn::Vec<decltype(d)>> pl;
     pl.e1x = get(b->e1x), pl.e1y = get(b->e1y), pl.e1z = get(b->e1z);
     pl.e2x = get(b->e2x), pl.e2y = get(b->e2y), pl.e2z = get(b->e2z);
@@ -89,6 +95,12 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     const auto ok = RefineOnPlane(d, dirX, dirY, dirZ, one, pl, &rb1, &rb2);
     // The interpolated barycentrics (a division) only where they are read.
     if (b->wantInterpolated || !hn::AllTrue(d, ok)) {
+      const auto x = hn::Load(d, b->x + i), y = hn::Load(d, b->y + i);
+      const auto ox = hn::Sub(x, get(b->x0)), oy = hn::Sub(y, get(b->y0));
+      const auto plane = [&](const double* v0, const double* dx, const double* dy) RASTRAY_LAMBDA_INLINE {
+        return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox)), hn::Mul(get(dy), oy));
+      };
+      const auto invW = plane(b->iw0, b->iwx, b->iwy);
       const auto inv = hn::Div(one, invW);
       const auto b1 = hn::Mul(plane(b->b10, b->b1x, b->b1y), inv);
       const auto b2 = hn::Mul(plane(b->b20, b->b2x, b->b2y), inv);
@@ -421,7 +433,23 @@ void PrimaryBatch::run() {
 PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footprintY,
                                    const uint32_t* colorIndex) {
   runFirst_[runs_] = uint32_t(used_);
+  // The kernel reads the per-hit inputs in place: lanes up to a multiple
+  // of 16 (every target's float lane count divides it) hold a copy of the
+  // last hit.
+  primary_detail::FusedBlock& b = *block_;
+  const size_t lanes = std::min(primary_detail::kBlock, (used_ + 15) / 16 * 16);
+  if (used_ > 0) {
+    const size_t last = used_ - 1;
+    for (size_t k = used_; k < lanes; ++k) {
+      b.run[k] = b.run[last];
+      b.run32[k] = b.run32[last];
+      b.dirX[k] = b.dirX[last], b.dirY[k] = b.dirY[last], b.dirZ[k] = b.dirZ[last];
+      b.kb1[k] = b.kb1[last], b.kb2[k] = b.kb2[last];
+    }
+  }
   PrimaryHitBlock h;
+  h.run64 = b.run;
+  h.lanes = lanes;
   h.runs = runs_;
   h.runFirst = runFirst_;
   h.count = used_;

@@ -155,11 +155,15 @@ class PrimaryBatch {
   }
   // hit(k).depth alone (hit(k) needs wantInterpolated(true)).
   float depth(size_t k) const { return block_->depth[k]; }
+  // depth(k) for every k < size().
+  const float* depths() const { return block_->depth; }
   // Whether hit(k) is read (its interpolated barycentrics are computed);
   // true until set.
   void wantInterpolated(bool want) { block_->wantInterpolated = want; }
   // The refined hits for the kernel; footprints and colour indices are the
-  // caller's (per sample, in the order added).
+  // caller's (per sample, in the order added). The per-hit inputs are the
+  // block's own, padded for the kernel to read in place
+  // (PrimaryHitBlock::run64, lanes).
   PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex);
   void clear() {
     used_ = 0;

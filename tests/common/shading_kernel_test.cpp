@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -526,6 +527,141 @@ TEST(ShadingKernel, RunCornersAndFaceNormalsGivenGiveTheKernelsOwnBits) {
     size_t changed = 0;
     for (size_t i = 0; i < n; ++i) changed += !sameBits(wrong[i], expected[i]);
     EXPECT_GT(changed, n / 4);
+  }
+}
+
+// The two-pass lanes (blocks whose lights need no visibility callback)
+// give the separate passes' bits: the eye light; point, spot and
+// directional lights with a range window; vertex colours (lanes that read
+// their own colours); authored normals (the Cornell box's); through both
+// entries (ShadeHits and blocks of runs) and blocks read in place (the
+// fused pass's), on every target.
+TEST(ShadingKernel, TwoPassLanesGiveTheSeparatePassesBits) {
+  Scene lit = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
+  Scene eyeLit = lit;
+  eyeLit.lights.clear();
+  Scene many = lit;
+  Light spot = many.lights.front();
+  spot.type = LightType::Spot;
+  spot.range = 4.5f;
+  spot.innerConeAngle = 0.3f;
+  spot.outerConeAngle = 0.9f;
+  spot.direction = glm::normalize(glm::dvec3(0.2, -1.0, -0.3));
+  spot.color = glm::vec3(0.9f, 0.6f, 0.3f);
+  Light sun = spot;
+  sun.type = LightType::Directional;
+  sun.direction = glm::normalize(glm::dvec3(-0.4, -0.5, -1.0));
+  many.lights.front().range = 2.5f;
+  many.lights.push_back(spot);
+  many.lights.push_back(sun);
+  many.colors.assign(many.positions.size(), glm::vec4(1.0f));
+  for (size_t v = 0; v < many.colors.size(); ++v)
+    many.colors[v] = glm::vec4(0.3f + 0.1f * float(v % 5), 0.8f - 0.05f * float(v % 7), 0.6f, 1.0f);
+  many.instances.front().hasColors = true;
+  for (const Scene* scene : {&lit, &eyeLit, &many}) {
+    SCOPED_TRACE(scene == &lit ? "light" : scene == &eyeLit ? "eye light" : "lights and vertex colours");
+    const Camera camera = makeCamera(*scene, {}, 64, 48);
+    const std::vector<ShadeHit> hits = primaryHits(*scene, camera, 1500);
+    ASSERT_GT(hits.size(), 500u);
+    const Shader shader(*scene, analyzeScene(*scene), camera, {}, nullptr, nullptr);
+    const size_t n = hits.size();
+    std::vector<int32_t> run(n);
+    std::vector<uint32_t> colorIndex(n);
+    HitColumns columns(hits);
+    for (size_t i = 0; i < n; ++i) colorIndex[i] = uint32_t(i);
+    const auto shadeBoth = [&](std::vector<glm::vec4>* viaHits, std::vector<glm::vec4>* viaBlocks) {
+      viaHits->assign(n, glm::vec4(-1.0f));
+      viaBlocks->assign(n, glm::vec4(-1.0f));
+      shadePrimaryHits(shader, hits.data(), n, viaHits->data(), ShadingPath::Kernel);
+      PrimaryHitShader kernel(shader, ShadingPath::Kernel);
+      std::vector<uint32_t> runInstance, runTriangle;
+      for (size_t first = 0; first < n; first += kPrimaryHitBlock) {
+        const size_t count = std::min(kPrimaryHitBlock, n - first);
+        runInstance.clear(), runTriangle.clear();
+        for (size_t k = 0; k < count; ++k) {
+          const ShadeHit& h = hits[first + k];
+          if (k == 0 || h.instance != runInstance.back() || h.triangle != runTriangle.back()) {
+            runInstance.push_back(h.instance);
+            runTriangle.push_back(h.triangle);
+          }
+          run[first + k] = int32_t(runInstance.size() - 1);
+        }
+        PrimaryHitBlock block;
+        block.count = count;
+        block.run = &run[first];
+        block.runInstance = runInstance.data();
+        block.runTriangle = runTriangle.data();
+        columns.into(block, first);
+        block.colorIndex = &colorIndex[first];
+        kernel.shade(block, viaBlocks->data());
+      }
+    };
+    // Blocks whose inputs the kernel reads in place (run64, lanes, runFirst,
+    // 64-byte aligned, padded with the last hit: the fused pass's block),
+    // colours to consecutive entries or scattered (reversed).
+    struct alignas(64) InPlace {
+      alignas(64) int32_t run[kPrimaryHitBlock];
+      alignas(64) int64_t run64[kPrimaryHitBlock];
+      alignas(64) double dx[kPrimaryHitBlock], dy[kPrimaryHitBlock], dz[kPrimaryHitBlock];
+      alignas(64) float b1[kPrimaryHitBlock], b2[kPrimaryHitBlock];
+    };
+    const auto shadeInPlace = [&](bool scattered) {
+      std::vector<glm::vec4> got(n, glm::vec4(-1.0f));
+      PrimaryHitShader kernel(shader, ShadingPath::Kernel);
+      auto in = std::make_unique<InPlace>();
+      std::vector<uint32_t> runInstance, runTriangle, runFirst, out(kPrimaryHitBlock);
+      for (size_t first = 0; first < n; first += kPrimaryHitBlock) {
+        const size_t count = std::min(kPrimaryHitBlock, n - first);
+        runInstance.clear(), runTriangle.clear(), runFirst.clear();
+        for (size_t k = 0; k < kPrimaryHitBlock; ++k) {
+          const ShadeHit& h = hits[first + std::min(k, count - 1)];  // padding: the last hit
+          if (k < count && (k == 0 || h.instance != runInstance.back() || h.triangle != runTriangle.back())) {
+            runInstance.push_back(h.instance);
+            runTriangle.push_back(h.triangle);
+            runFirst.push_back(uint32_t(k));
+          }
+          in->run[k] = int32_t(runInstance.size() - 1);
+          in->run64[k] = int64_t(runInstance.size() - 1);
+          in->dx[k] = h.direction.x, in->dy[k] = h.direction.y, in->dz[k] = h.direction.z;
+          in->b1[k] = h.b1, in->b2[k] = h.b2;
+          out[k] = uint32_t(scattered ? n - 1 - (first + k) : first + k);
+        }
+        runFirst.push_back(uint32_t(count));
+        PrimaryHitBlock block;
+        block.count = count;
+        block.run = in->run;
+        block.run64 = in->run64;
+        block.lanes = kPrimaryHitBlock;
+        block.runs = runInstance.size();
+        block.runFirst = runFirst.data();
+        block.runInstance = runInstance.data();
+        block.runTriangle = runTriangle.data();
+        block.dirX = in->dx, block.dirY = in->dy, block.dirZ = in->dz;
+        block.b1 = in->b1, block.b2 = in->b2;
+        block.footprintX = &columns.fx[first], block.footprintY = &columns.fy[first];
+        block.colorIndex = out.data();
+        kernel.shade(block, got.data());
+      }
+      if (scattered) std::reverse(got.begin(), got.end());
+      return got;
+    };
+    for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      SCOPED_TRACE(hwy::TargetName(target));
+      hwy::SetSupportedTargetsForTest(target);
+      std::vector<glm::vec4> passesHits, passesBlocks, twoHits, twoBlocks;
+      setTwoPassShadingForTest(false);
+      shadeBoth(&passesHits, &passesBlocks);
+      setTwoPassShadingForTest(true);
+      shadeBoth(&twoHits, &twoBlocks);
+      const std::vector<glm::vec4> inPlace = shadeInPlace(false), inPlaceScattered = shadeInPlace(true);
+      for (size_t i = 0; i < n; ++i) {
+        ASSERT_TRUE(sameBits(twoHits[i], passesHits[i])) << "hit " << i;
+        ASSERT_TRUE(sameBits(twoBlocks[i], passesBlocks[i])) << "hit " << i;
+        ASSERT_TRUE(sameBits(inPlace[i], passesHits[i])) << "in place, hit " << i;
+        ASSERT_TRUE(sameBits(inPlaceScattered[i], passesHits[i])) << "in place, scattered, hit " << i;
+      }
+    }
+    hwy::SetSupportedTargetsForTest(0);
   }
 }
 
