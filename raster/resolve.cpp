@@ -85,6 +85,53 @@ void LanesLeanRow1(const float* color, const float* depthIn, const uint32_t* win
   }
 }
 
+// The lean form at 4 spp, one row piece of `width` pixels: each pixel's
+// depth and ids from its centre sample (`centre`), as resolveTileLean's
+// loop for several spp, a vector of pixels at a time: the centre samples'
+// winners and depths de-interleaved from the four samples of each pixel,
+// the depth selected in lanes, the ids written whole where one setup (or
+// none) won every centre sample of the vector, else pixel by pixel.
+void LanesLeanCentre4(const float* depthIn, const uint32_t* winners, const TriangleSetup* setups,
+                      size_t width, int centre, float* depthOut, uint32_t* instanceOut,
+                      uint32_t* triangleOut) {
+  const hn::ScalableTag<float> df;
+  const hn::RebindToUnsigned<decltype(df)> du;
+  const size_t N = hn::Lanes(df);
+  const SampleHit none;
+  const auto noSetup = hn::Set(du, kNoSetup);
+  const auto noDepth = hn::Set(df, none.depth);
+  size_t i = 0;
+  for (; i + N <= width; i += N) {
+    hn::Vec<decltype(du)> w0, w1, w2, w3;
+    hn::LoadInterleaved4(du, winners + 4 * i, w0, w1, w2, w3);
+    hn::Vec<decltype(df)> d0, d1, d2, d3;
+    hn::LoadInterleaved4(df, depthIn + 4 * i, d0, d1, d2, d3);
+    const auto w = centre == 0 ? w0 : centre == 1 ? w1 : centre == 2 ? w2 : w3;
+    const auto d = centre == 0 ? d0 : centre == 1 ? d1 : centre == 2 ? d2 : d3;
+    hn::StoreU(hn::IfThenElse(hn::RebindMask(df, hn::Ne(w, noSetup)), d, noDepth), df, depthOut + i);
+    const uint32_t first = hn::GetLane(w);
+    if (hn::AllTrue(du, hn::Eq(w, hn::Set(du, first)))) {
+      hn::StoreU(hn::Set(du, first == kNoSetup ? none.instance : setups[first].instance), du,
+                 instanceOut + i);
+      hn::StoreU(hn::Set(du, first == kNoSetup ? none.triangle : setups[first].triangle), du,
+                 triangleOut + i);
+      continue;
+    }
+    for (size_t j = i; j < i + N; ++j) {
+      const uint32_t win = winners[4 * j + size_t(centre)];
+      instanceOut[j] = win == kNoSetup ? none.instance : setups[win].instance;
+      triangleOut[j] = win == kNoSetup ? none.triangle : setups[win].triangle;
+    }
+  }
+  for (; i < width; ++i) {
+    const size_t c = 4 * i + size_t(centre);
+    const uint32_t win = winners[c];
+    depthOut[i] = win == kNoSetup ? none.depth : depthIn[c];
+    instanceOut[i] = win == kNoSetup ? none.instance : setups[win].instance;
+    triangleOut[i] = win == kNoSetup ? none.triangle : setups[win].triangle;
+  }
+}
+
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE
 }  // namespace rastray
@@ -104,6 +151,7 @@ HWY_AFTER_NAMESPACE();
 namespace rastray {
 
 HWY_EXPORT(LanesLeanRow1);
+HWY_EXPORT(LanesLeanCentre4);
 
 namespace {
 
@@ -192,6 +240,15 @@ void resolveTileLean(const TileRect& rect, int spp, int centreSample, const Tile
       // Samples without a winner hold no colour: the full form's 0.
       boxFilterCovered(samples.color.data() + row, winners, kNoSetup, spp, width, color,
                        samples.uniformShared);
+      if (spp == 4) {
+        HWY_DYNAMIC_DISPATCH(LanesLeanCentre4)
+        (samples.depth.data() + row, winners, setups, width, centreSample, depth, instance, triangle);
+        streamCopy(image->color.data() + first, color, width * sizeof(glm::vec4));
+        streamCopy(image->depth.data() + first, depth, width * sizeof(float));
+        streamCopy(image->instance.data() + first, instance, width * sizeof(uint32_t));
+        streamCopy(image->triangle.data() + first, triangle, width * sizeof(uint32_t));
+        continue;
+      }
       for (size_t i = 0; i < width; ++i) {
         const size_t c = i * size_t(spp) + size_t(centreSample);
         const uint32_t w = winners[c];

@@ -129,24 +129,26 @@ TEST(Resolve, LeanFormGivesTheFullFormsPixels) {
         a.depth[p] = b.depth[p] = -7.0f;
         a.instance[p] = b.instance[p] = a.triangle[p] = b.triangle[p] = 0xDEADBEEFu;
       }
-      const int centre = spp == 1 ? 0 : 1;
-      resolveTile(rect, spp, centre, full, &a);
-      const std::string what =
-          "spp " + std::to_string(spp) + (frameTarget ? " frame target" : " tile target");
-      for (int64_t simd : hwy::SupportedAndGeneratedTargets()) {
-        hwy::SetSupportedTargetsForTest(simd);
-        resolveTileLean(rect, spp, centre, lean, target, setups.data(), &b);
-        EXPECT_EQ(0, std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(glm::vec4)))
-            << what << " " << hwy::TargetName(simd);
-        EXPECT_EQ(0, std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)))
-            << what << " " << hwy::TargetName(simd);
-        EXPECT_EQ(a.instance, b.instance) << what << " " << hwy::TargetName(simd);
-        EXPECT_EQ(a.triangle, b.triangle) << what << " " << hwy::TargetName(simd);
+      // Every sample as the centre (the 4-spp lanes pick it among four).
+      for (int centre = 0; centre < spp; ++centre) {
+        resolveTile(rect, spp, centre, full, &a);
+        const std::string what = "spp " + std::to_string(spp) + " centre " + std::to_string(centre) +
+                                 (frameTarget ? " frame target" : " tile target");
+        for (int64_t simd : hwy::SupportedAndGeneratedTargets()) {
+          hwy::SetSupportedTargetsForTest(simd);
+          resolveTileLean(rect, spp, centre, lean, target, setups.data(), &b);
+          EXPECT_EQ(0, std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(glm::vec4)))
+              << what << " " << hwy::TargetName(simd);
+          EXPECT_EQ(0, std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)))
+              << what << " " << hwy::TargetName(simd);
+          EXPECT_EQ(a.instance, b.instance) << what << " " << hwy::TargetName(simd);
+          EXPECT_EQ(a.triangle, b.triangle) << what << " " << hwy::TargetName(simd);
+        }
+        hwy::SetSupportedTargetsForTest(0);
+        size_t background = 0;
+        for (int x = rect.x0; x < rect.x1; ++x) background += a.instance[a.index(x, 3)] == kNoId;
+        EXPECT_GT(background, 0u) << what;
       }
-      hwy::SetSupportedTargetsForTest(0);
-      size_t background = 0;
-      for (int x = rect.x0; x < rect.x1; ++x) background += a.instance[a.index(x, 3)] == kNoId;
-      EXPECT_GT(background, 0u) << what;
     }
   }
 }
