@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include <hwy/highway.h>
 
@@ -85,6 +86,78 @@ void LanesLeanRow1(const float* color, const float* depthIn, const uint32_t* win
   }
 }
 
+// The lean form at 4 spp, one row piece of `width` pixels: each pixel's
+// depth and ids from its centre sample (`centre`), as resolveTileLean's
+// loop for several spp, a vector of pixels at a time: the centre samples'
+// winners and depths de-interleaved from the four samples of each pixel,
+// the depth selected in lanes, the ids written whole where one setup (or
+// none) won every centre sample of the vector, else pixel by pixel.
+void LanesLeanCentre4(const float* depthIn, const uint32_t* winners, const TriangleSetup* setups,
+                      size_t width, int centre, float* depthOut, uint32_t* instanceOut,
+                      uint32_t* triangleOut) {
+  const hn::ScalableTag<float> df;
+  const hn::RebindToUnsigned<decltype(df)> du;
+  const size_t N = hn::Lanes(df);
+  const SampleHit none;
+  const auto noSetup = hn::Set(du, kNoSetup);
+  const auto noDepth = hn::Set(df, none.depth);
+  size_t i = 0;
+  for (; i + N <= width; i += N) {
+    hn::Vec<decltype(du)> w0, w1, w2, w3;
+    hn::LoadInterleaved4(du, winners + 4 * i, w0, w1, w2, w3);
+    hn::Vec<decltype(df)> d0, d1, d2, d3;
+    hn::LoadInterleaved4(df, depthIn + 4 * i, d0, d1, d2, d3);
+    const auto w = centre == 0 ? w0 : centre == 1 ? w1 : centre == 2 ? w2 : w3;
+    const auto d = centre == 0 ? d0 : centre == 1 ? d1 : centre == 2 ? d2 : d3;
+    hn::StoreU(hn::IfThenElse(hn::RebindMask(df, hn::Ne(w, noSetup)), d, noDepth), df, depthOut + i);
+    const uint32_t first = hn::GetLane(w);
+    if (hn::AllTrue(du, hn::Eq(w, hn::Set(du, first)))) {
+      hn::StoreU(hn::Set(du, first == kNoSetup ? none.instance : setups[first].instance), du,
+                 instanceOut + i);
+      hn::StoreU(hn::Set(du, first == kNoSetup ? none.triangle : setups[first].triangle), du,
+                 triangleOut + i);
+      continue;
+    }
+    for (size_t j = i; j < i + N; ++j) {
+      const uint32_t win = winners[4 * j + size_t(centre)];
+      instanceOut[j] = win == kNoSetup ? none.instance : setups[win].instance;
+      triangleOut[j] = win == kNoSetup ? none.triangle : setups[win].triangle;
+    }
+  }
+  for (; i < width; ++i) {
+    const size_t c = 4 * i + size_t(centre);
+    const uint32_t win = winners[c];
+    depthOut[i] = win == kNoSetup ? none.depth : depthIn[c];
+    instanceOut[i] = win == kNoSetup ? none.instance : setups[win].instance;
+    triangleOut[i] = win == kNoSetup ? none.triangle : setups[win].triangle;
+  }
+}
+
+// Copies `count` 4-byte words from `src` to `dst` (4-byte aligned) with
+// non-temporal stores: 16 bytes at a time until `dst` is aligned to a
+// whole vector, then whole vectors (64 bytes on AVX-512: one store per
+// cache line), then 16 bytes at a time, and the last words under 16 bytes
+// with plain stores. A line written by one wide store leaves the write-
+// combining buffer whole, and takes one store-buffer entry instead of
+// four: in the frame, the resolve's write of the image stalls the core on
+// a full store buffer (docs/PERFORMANCE.md, "The resolve and the image
+// write"). The words are copied, never computed with (bits kept).
+void LanesStreamCopy(const uint32_t* src, uint32_t* dst, size_t count) {
+  const hn::ScalableTag<uint32_t> d;
+  const hn::CappedTag<uint32_t, 4> d4;
+  const size_t N = hn::Lanes(d), N4 = hn::Lanes(d4);
+  size_t i = 0;
+  // Plain stores until 16-byte aligned (the image's rows are, except
+  // where a plane of 4-byte values starts a row at another pixel).
+  for (; i < count && reinterpret_cast<uintptr_t>(dst + i) % (N4 * sizeof(uint32_t)) != 0; ++i)
+    std::memcpy(dst + i, src + i, sizeof(uint32_t));
+  for (; i + N4 <= count && reinterpret_cast<uintptr_t>(dst + i) % (N * sizeof(uint32_t)) != 0; i += N4)
+    hn::Stream(hn::LoadU(d4, src + i), d4, dst + i);
+  for (; i + N <= count; i += N) hn::Stream(hn::LoadU(d, src + i), d, dst + i);
+  for (; i + N4 <= count; i += N4) hn::Stream(hn::LoadU(d4, src + i), d4, dst + i);
+  if (i < count) std::memcpy(dst + i, src + i, (count - i) * sizeof(uint32_t));
+}
+
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE
 }  // namespace rastray
@@ -104,28 +177,24 @@ HWY_AFTER_NAMESPACE();
 namespace rastray {
 
 HWY_EXPORT(LanesLeanRow1);
+HWY_EXPORT(LanesLeanCentre4);
+HWY_EXPORT(LanesStreamCopy);
 
 namespace {
 
-// Copies `bytes` (a multiple of 4) to `dst` with stores that bypass the
-// caches where the CPU has them (SSE2 non-temporal stores on the 16-byte
-// aligned middle; plain stores at the ends). The frame's image is written
-// once per frame and is far larger than the caches: plain stores would
-// first read every line of it from memory only to overwrite it. Callers
-// end the tile with streamFence() before another thread may read the image.
+// Copies `bytes` to `dst` with stores that bypass the caches
+// (LanesStreamCopy: non-temporal stores of the widest vector `dst` is
+// aligned to). The frame's image is written once per frame and is far
+// larger than the caches: plain stores would first read every line of it
+// from memory only to overwrite it. Callers end the tile with
+// streamFence() before another thread may read the image.
 void streamCopy(void* dst, const void* src, size_t bytes) {
-#if defined(__SSE2__)
-  auto* d = static_cast<char*>(dst);
-  const auto* s = static_cast<const char*>(src);
-  const size_t head = std::min(bytes, size_t((16 - reinterpret_cast<uintptr_t>(d) % 16) % 16));
-  std::memcpy(d, s, head);
-  d += head, s += head, bytes -= head;
-  for (; bytes >= 16; d += 16, s += 16, bytes -= 16)
-    _mm_stream_si128(reinterpret_cast<__m128i*>(d), _mm_loadu_si128(reinterpret_cast<const __m128i*>(s)));
-  std::memcpy(d, s, bytes);
-#else
-  std::memcpy(dst, src, bytes);
-#endif
+  if (bytes % 4 != 0 || reinterpret_cast<uintptr_t>(dst) % 4 != 0) {
+    std::memcpy(dst, src, bytes);
+    return;
+  }
+  HWY_DYNAMIC_DISPATCH(LanesStreamCopy)
+  (static_cast<const uint32_t*>(src), static_cast<uint32_t*>(dst), bytes / 4);
 }
 
 void streamFence() {
@@ -192,6 +261,15 @@ void resolveTileLean(const TileRect& rect, int spp, int centreSample, const Tile
       // Samples without a winner hold no colour: the full form's 0.
       boxFilterCovered(samples.color.data() + row, winners, kNoSetup, spp, width, color,
                        samples.uniformShared);
+      if (spp == 4) {
+        HWY_DYNAMIC_DISPATCH(LanesLeanCentre4)
+        (samples.depth.data() + row, winners, setups, width, centreSample, depth, instance, triangle);
+        streamCopy(image->color.data() + first, color, width * sizeof(glm::vec4));
+        streamCopy(image->depth.data() + first, depth, width * sizeof(float));
+        streamCopy(image->instance.data() + first, instance, width * sizeof(uint32_t));
+        streamCopy(image->triangle.data() + first, triangle, width * sizeof(uint32_t));
+        continue;
+      }
       for (size_t i = 0; i < width; ++i) {
         const size_t c = i * size_t(spp) + size_t(centreSample);
         const uint32_t w = winners[c];

@@ -51,8 +51,12 @@ TEST(BoxFilter, EverySampleCountGivesTheScalarLoopsBits) {
 TEST(BoxFilter, CoveredSamplesGiveTheBitsOfZeroedEmptySamples) {
   std::mt19937 rng(8);
   std::uniform_real_distribution<float> value(-2.0f, 2.0f);
+  // Tiny values too: sums whose quotient is subnormal and rounds (the
+  // 4-spp lanes multiply by 0.25 instead of dividing by 4).
+  std::uniform_real_distribution<float> tiny(-1e-37f, 1e-37f);
   const float specials[] = {-0.0f, std::numeric_limits<float>::quiet_NaN(),
-                            std::numeric_limits<float>::infinity(), 3e38f};
+                            std::numeric_limits<float>::infinity(), 3e38f,
+                            3 * std::numeric_limits<float>::denorm_min()};
   const uint32_t none = 0xFFFFFFFFu;
   for (int64_t target : hwy::SupportedAndGeneratedTargets())
     for (int spp : {1, 2, 4, 9, 16})
@@ -62,8 +66,10 @@ TEST(BoxFilter, CoveredSamplesGiveTheBitsOfZeroedEmptySamples) {
         for (size_t i = 0; i < samples.size(); ++i) {
           // Runs of covered and empty samples, empty pixels among them.
           covered[i] = (i / 3 + rng() % 2) % 3 == 0 ? none : uint32_t(rng() % 7);
-          for (int k = 0; k < 4; ++k)
-            samples[i][k] = rng() % 5 == 0 ? specials[rng() % std::size(specials)] : value(rng);
+          for (int k = 0; k < 4; ++k) {
+            const uint32_t r = rng() % 10;
+            samples[i][k] = r < 2 ? specials[rng() % std::size(specials)] : r < 4 ? tiny(rng) : value(rng);
+          }
           zeroed[i] = covered[i] == none ? glm::vec4(0.0f) : samples[i];
         }
         std::vector<glm::vec4> got(pixels), expected(pixels);

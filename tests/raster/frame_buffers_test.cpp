@@ -219,5 +219,20 @@ TEST(FrameBuffers, TileSamplesLeftByAnotherFrameDoNotShow) {
   }
 }
 
+// A frame's fresh image (no pool, or an empty one) has FlatImage(w, h)'s
+// pixels, bit for bit, also where its planes are large enough for the
+// huge-page advice and the one-call fault-in (640×480: 4.9 MB of colour).
+TEST(FrameBuffers, FreshImageIsTheEmptyImage) {
+  for (const auto& [w, h] : {std::pair{640, 480}, std::pair{7, 3}}) {
+    const FlatImage empty(w, h);
+    RasterFrameBuffers pool;
+    for (RasterFrameBuffers* p : {static_cast<RasterFrameBuffers*>(nullptr), &pool}) {
+      FrameBufferLease lease(p);
+      expectSameImage(lease.image(w, h), empty,
+                      std::to_string(w) + "x" + std::to_string(h) + (p ? " pool" : " no pool"));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rastray

@@ -41,30 +41,37 @@ TEST(Resolve, WritesExactlyTheTilesPixelsAtAnyRowAlignment) {
           image.instance[p] = image.triangle[p] = 0xDEADBEEFu;
         }
         const int centre = spp == 1 ? 0 : 2;
-        resolveTile(rect, spp, centre, samples, &image);
-        for (int y = 0; y < height; ++y)
-          for (int x = 0; x < width; ++x) {
-            const size_t p = image.index(x, y);
-            const bool inside = x >= rect.x0 && x < rect.x1 && y >= rect.y0 && y < rect.y1;
-            SCOPED_TRACE("spp " + std::to_string(spp) + " width " + std::to_string(width) + " x0 " +
-                         std::to_string(x0) + " pixel " + std::to_string(x) + "," + std::to_string(y));
-            if (!inside) {
-              ASSERT_EQ(image.color[p], glm::vec4(sentinel));
-              ASSERT_EQ(image.depth[p], sentinel);
-              ASSERT_EQ(image.instance[p], 0xDEADBEEFu);
-              ASSERT_EQ(image.triangle[p], 0xDEADBEEFu);
-              continue;
+        // On every target: the image's rows are streamed out in its widest
+        // vectors where aligned (also the ends of unaligned rows).
+        for (int64_t simd : hwy::SupportedAndGeneratedTargets()) {
+          hwy::SetSupportedTargetsForTest(simd);
+          resolveTile(rect, spp, centre, samples, &image);
+          hwy::SetSupportedTargetsForTest(0);
+          for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x) {
+              const size_t p = image.index(x, y);
+              const bool inside = x >= rect.x0 && x < rect.x1 && y >= rect.y0 && y < rect.y1;
+              SCOPED_TRACE("spp " + std::to_string(spp) + " width " + std::to_string(width) + " x0 " +
+                           std::to_string(x0) + " pixel " + std::to_string(x) + "," + std::to_string(y) +
+                           " " + hwy::TargetName(simd));
+              if (!inside) {
+                ASSERT_EQ(image.color[p], glm::vec4(sentinel));
+                ASSERT_EQ(image.depth[p], sentinel);
+                ASSERT_EQ(image.instance[p], 0xDEADBEEFu);
+                ASSERT_EQ(image.triangle[p], 0xDEADBEEFu);
+                continue;
+              }
+              // The box filter: (0 + s0 + … ) / spp, in sample order.
+              glm::vec4 sum(0.0f);
+              for (int s = 0; s < spp; ++s) sum += samples.color[index(x, y, s)];
+              const glm::vec4 expected = sum / float(spp);
+              ASSERT_EQ(0, std::memcmp(&image.color[p], &expected, sizeof expected));
+              const SampleHit& h = samples.front[index(x, y, centre)];
+              ASSERT_EQ(image.depth[p], h.depth);
+              ASSERT_EQ(image.instance[p], h.instance);
+              ASSERT_EQ(image.triangle[p], h.triangle);
             }
-            // The box filter: (0 + s0 + … ) / spp, in sample order.
-            glm::vec4 sum(0.0f);
-            for (int s = 0; s < spp; ++s) sum += samples.color[index(x, y, s)];
-            const glm::vec4 expected = sum / float(spp);
-            ASSERT_EQ(0, std::memcmp(&image.color[p], &expected, sizeof expected));
-            const SampleHit& h = samples.front[index(x, y, centre)];
-            ASSERT_EQ(image.depth[p], h.depth);
-            ASSERT_EQ(image.instance[p], h.instance);
-            ASSERT_EQ(image.triangle[p], h.triangle);
-          }
+        }
       }
     }
   }
@@ -129,24 +136,26 @@ TEST(Resolve, LeanFormGivesTheFullFormsPixels) {
         a.depth[p] = b.depth[p] = -7.0f;
         a.instance[p] = b.instance[p] = a.triangle[p] = b.triangle[p] = 0xDEADBEEFu;
       }
-      const int centre = spp == 1 ? 0 : 1;
-      resolveTile(rect, spp, centre, full, &a);
-      const std::string what =
-          "spp " + std::to_string(spp) + (frameTarget ? " frame target" : " tile target");
-      for (int64_t simd : hwy::SupportedAndGeneratedTargets()) {
-        hwy::SetSupportedTargetsForTest(simd);
-        resolveTileLean(rect, spp, centre, lean, target, setups.data(), &b);
-        EXPECT_EQ(0, std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(glm::vec4)))
-            << what << " " << hwy::TargetName(simd);
-        EXPECT_EQ(0, std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)))
-            << what << " " << hwy::TargetName(simd);
-        EXPECT_EQ(a.instance, b.instance) << what << " " << hwy::TargetName(simd);
-        EXPECT_EQ(a.triangle, b.triangle) << what << " " << hwy::TargetName(simd);
+      // Every sample as the centre (the 4-spp lanes pick it among four).
+      for (int centre = 0; centre < spp; ++centre) {
+        resolveTile(rect, spp, centre, full, &a);
+        const std::string what = "spp " + std::to_string(spp) + " centre " + std::to_string(centre) +
+                                 (frameTarget ? " frame target" : " tile target");
+        for (int64_t simd : hwy::SupportedAndGeneratedTargets()) {
+          hwy::SetSupportedTargetsForTest(simd);
+          resolveTileLean(rect, spp, centre, lean, target, setups.data(), &b);
+          EXPECT_EQ(0, std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(glm::vec4)))
+              << what << " " << hwy::TargetName(simd);
+          EXPECT_EQ(0, std::memcmp(a.depth.data(), b.depth.data(), a.depth.size() * sizeof(float)))
+              << what << " " << hwy::TargetName(simd);
+          EXPECT_EQ(a.instance, b.instance) << what << " " << hwy::TargetName(simd);
+          EXPECT_EQ(a.triangle, b.triangle) << what << " " << hwy::TargetName(simd);
+        }
+        hwy::SetSupportedTargetsForTest(0);
+        size_t background = 0;
+        for (int x = rect.x0; x < rect.x1; ++x) background += a.instance[a.index(x, 3)] == kNoId;
+        EXPECT_GT(background, 0u) << what;
       }
-      hwy::SetSupportedTargetsForTest(0);
-      size_t background = 0;
-      for (int x = rect.x0; x < rect.x1; ++x) background += a.instance[a.index(x, 3)] == kNoId;
-      EXPECT_GT(background, 0u) << what;
     }
   }
 }
