@@ -551,6 +551,7 @@ TEST_F(ServeTest, SettingsRoundTripThroughTheCommandLine) {
       "&renderer=hybrid&size=48,40&shadows=none&max-depth=0&wireframe=on&halo=on",
       "&renderer=raytrace&size=50,30&spp=2&max-depth=0&origin=world&eye=1.5,0.25,3&target=0,0,0&up=0,1,0",
       "&renderer=raytrace&size=40,30&transparency-cutoff=0&ray-offset=float-ulps&no-packets=on&yfov=60",
+      "&renderer=hybrid&size=48,40&shadows=rays&no-shadow-packets=on",
       "&renderer=hybrid&size=48,40&lights=none&camera=0",
       "&renderer=raster&size=40,30&lights=0&camera=0&eye=0.3,0.1,3&target=0,0,0&up=0,1,0",
   };
