@@ -192,37 +192,50 @@ void LanesToLight(LaneBlock* b, double lightX, double lightY, double lightZ) {
 // The lighting normal of each lane (Shader::shade's n): the shading
 // normal (authored, interpolated and normalised; else the face normal) on
 // the viewer's side, or the face normal's when that one faces away.
+// The lighting normal of lanes i.. (Shader::shade's n) from their
+// barycentrics: the authored normal interpolated and normalised (else the
+// face normal), on the viewer's side, or the face normal's when that one
+// faces away. One function for both lane paths: their bits must agree.
+template <class D, class Get>
+HWY_INLINE void FacingNormal(D d, const LaneBlock* b, const Get& get, size_t i, hn::Vec<D> b0, hn::Vec<D> b1,
+                             hn::Vec<D> b2, hn::Vec<D> dx, hn::Vec<D> dy, hn::Vec<D> dz, hn::Vec<D>* nx,
+                             hn::Vec<D>* ny, hn::Vec<D>* nz) {
+  const auto zero = hn::Zero(d);
+  const auto inf = hn::Set(d, std::numeric_limits<float>::infinity());
+  const auto sx =
+      hn::Add(hn::Add(hn::Mul(b0, get(b->n0X)), hn::Mul(b1, get(b->n1X))), hn::Mul(b2, get(b->n2X)));
+  const auto sy =
+      hn::Add(hn::Add(hn::Mul(b0, get(b->n0Y)), hn::Mul(b1, get(b->n1Y))), hn::Mul(b2, get(b->n2Y)));
+  const auto sz =
+      hn::Add(hn::Add(hn::Mul(b0, get(b->n0Z)), hn::Mul(b1, get(b->n1Z))), hn::Mul(b2, get(b->n2Z)));
+  const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(sx, sx), hn::Mul(sy, sy)), hn::Mul(sz, sz)));
+  const auto gx = get(b->ngX), gy = get(b->ngY), gz = get(b->ngZ);
+  // A zero (or overflowing) interpolated normal keeps the face normal.
+  const auto useAuthored =
+      hn::And(hn::Gt(get(b->authored), zero), hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
+  const auto side = hn::Load(d, b->side + i);
+  const auto fx = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sx, length), gx));
+  const auto fy = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sy, length), gy));
+  const auto fz = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sz, length), gz));
+  // facing·(−d) > 0, written as facing·d < 0 (negation is exact).
+  const auto facingDot = hn::Add(hn::Add(hn::Mul(fx, dx), hn::Mul(fy, dy)), hn::Mul(fz, dz));
+  const auto faces = hn::Lt(facingDot, zero);
+  *nx = hn::IfThenElse(faces, fx, hn::Mul(side, gx));
+  *ny = hn::IfThenElse(faces, fy, hn::Mul(side, gy));
+  *nz = hn::IfThenElse(faces, fz, hn::Mul(side, gz));
+}
+
 // Clears the Lambert sum; with the eye light, sets it to |n·d|.
 void LanesNormals(LaneBlock* b, bool eyeLight) {
   const hn::ScalableTag<float> d;
   const size_t N = hn::Lanes(d);
   const auto zero = hn::Zero(d);
-  const auto inf = hn::Set(d, std::numeric_limits<float>::infinity());
   for (size_t i = 0; i < b->lanes; i += N) {
     const RunLanes<decltype(d)> get(d, b->run, i);  // per-run values (common/run_lanes-inl.h)
-    const auto b0 = hn::Load(d, b->b0 + i), b1 = hn::Load(d, b->b1 + i), b2 = hn::Load(d, b->b2 + i);
-    const auto sx =
-        hn::Add(hn::Add(hn::Mul(b0, get(b->n0X)), hn::Mul(b1, get(b->n1X))), hn::Mul(b2, get(b->n2X)));
-    const auto sy =
-        hn::Add(hn::Add(hn::Mul(b0, get(b->n0Y)), hn::Mul(b1, get(b->n1Y))), hn::Mul(b2, get(b->n2Y)));
-    const auto sz =
-        hn::Add(hn::Add(hn::Mul(b0, get(b->n0Z)), hn::Mul(b1, get(b->n1Z))), hn::Mul(b2, get(b->n2Z)));
-    const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(sx, sx), hn::Mul(sy, sy)), hn::Mul(sz, sz)));
-    const auto gx = get(b->ngX), gy = get(b->ngY), gz = get(b->ngZ);
-    // A zero (or overflowing) interpolated normal keeps the face normal.
-    const auto useAuthored =
-        hn::And(hn::Gt(get(b->authored), zero), hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
-    const auto side = hn::Load(d, b->side + i);
-    const auto fx = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sx, length), gx));
-    const auto fy = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sy, length), gy));
-    const auto fz = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sz, length), gz));
     const auto dx = hn::Load(d, b->dirX + i), dy = hn::Load(d, b->dirY + i), dz = hn::Load(d, b->dirZ + i);
-    // facing·(−d) > 0, written as facing·d < 0 (negation is exact).
-    const auto facingDot = hn::Add(hn::Add(hn::Mul(fx, dx), hn::Mul(fy, dy)), hn::Mul(fz, dz));
-    const auto faces = hn::Lt(facingDot, zero);
-    const auto nx = hn::IfThenElse(faces, fx, hn::Mul(side, gx));
-    const auto ny = hn::IfThenElse(faces, fy, hn::Mul(side, gy));
-    const auto nz = hn::IfThenElse(faces, fz, hn::Mul(side, gz));
+    hn::Vec<decltype(d)> nx, ny, nz;
+    FacingNormal(d, b, get, i, hn::Load(d, b->b0 + i), hn::Load(d, b->b1 + i), hn::Load(d, b->b2 + i), dx, dy,
+                 dz, &nx, &ny, &nz);
     hn::Store(nx, d, b->nX + i);
     hn::Store(ny, d, b->nY + i);
     hn::Store(nz, d, b->nZ + i);
@@ -386,33 +399,15 @@ void LanesLightsFinish(LaneBlock* b, const LaneInputs* in, const LaneLight* ligh
   const hn::ScalableTag<float> df;
   const size_t N = hn::Lanes(df);
   const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
-  const auto inf = hn::Set(df, std::numeric_limits<float>::infinity());
   const auto invPi = hn::Set(df, eyeLight ? 1.0f : float(0.31830988618379067154));
   const bool perLane = b->colourPerLane;
   for (size_t i = 0; i < b->lanes; i += N) {
     const RunLanes<decltype(df)> get(df, in->run, i);
     // LanesNormals.
-    const auto b0f = hn::Load(df, b->b0 + i), b1f = hn::Load(df, in->b1 + i), b2f = hn::Load(df, in->b2 + i);
-    const auto sx =
-        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0X)), hn::Mul(b1f, get(b->n1X))), hn::Mul(b2f, get(b->n2X)));
-    const auto sy =
-        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0Y)), hn::Mul(b1f, get(b->n1Y))), hn::Mul(b2f, get(b->n2Y)));
-    const auto sz =
-        hn::Add(hn::Add(hn::Mul(b0f, get(b->n0Z)), hn::Mul(b1f, get(b->n1Z))), hn::Mul(b2f, get(b->n2Z)));
-    const auto length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(sx, sx), hn::Mul(sy, sy)), hn::Mul(sz, sz)));
-    const auto gx = get(b->ngX), gy = get(b->ngY), gz = get(b->ngZ);
-    const auto useAuthored =
-        hn::And(hn::Gt(get(b->authored), zero), hn::And(hn::Gt(length, zero), hn::Lt(length, inf)));
-    const auto side = hn::Load(df, b->side + i);
-    const auto fx = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sx, length), gx));
-    const auto fy = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sy, length), gy));
-    const auto fz = hn::Mul(side, hn::IfThenElse(useAuthored, hn::Div(sz, length), gz));
     const auto dx = hn::Load(df, b->dirX + i), dy = hn::Load(df, b->dirY + i), dz = hn::Load(df, b->dirZ + i);
-    const auto facingDot = hn::Add(hn::Add(hn::Mul(fx, dx), hn::Mul(fy, dy)), hn::Mul(fz, dz));
-    const auto faces = hn::Lt(facingDot, zero);
-    const auto nx = hn::IfThenElse(faces, fx, hn::Mul(side, gx));
-    const auto ny = hn::IfThenElse(faces, fy, hn::Mul(side, gy));
-    const auto nz = hn::IfThenElse(faces, fz, hn::Mul(side, gz));
+    hn::Vec<decltype(df)> nx, ny, nz;
+    FacingNormal(df, b, get, i, hn::Load(df, b->b0 + i), hn::Load(df, in->b1 + i), hn::Load(df, in->b2 + i),
+                 dx, dy, dz, &nx, &ny, &nz);
     hn::Vec<decltype(df)> sumR, sumG, sumB;
     if (eyeLight) {
       const auto cosine = hn::Abs(hn::Add(hn::Add(hn::Mul(nx, dx), hn::Mul(ny, dy)), hn::Mul(nz, dz)));
