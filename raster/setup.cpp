@@ -156,40 +156,50 @@ SetupOutcome setupEdges(const ClipSpace& space, const SampleGrid& grid, const gl
   return SetupOutcome::Ok;
 }
 
-// The scalar reference of setupPlanes: one division per plane
-// coefficient and per vertex attribute, in the order written.
-void setupPlanesScalar(const SampleGrid& grid, const DepthSettings& ds, const ClipVertex v[3],
-                       const glm::dvec2 image[3], const int order[3], TriangleSetup* t) {
-  const double U = double(grid.unitsPerPixel);
-  const ClipVertex* cv[3] = {&v[order[0]], &v[order[1]], &v[order[2]]};
+// Marks the edges that are the original triangle's (both ends with a zero
+// weight for the same corner) and returns the clip vertices in v's order.
+void markOriginalEdges(const ClipVertex v[3], const int order[3], const ClipVertex* cv[3], TriangleSetup* t) {
+  for (int i = 0; i < 3; ++i) cv[i] = &v[order[i]];
   for (int i = 0; i < 3; ++i) {
     const int j = (i + 1) % 3;
     for (int k = 0; k < 3; ++k)
       if (cv[i]->bary[k] == 0.0 && cv[j]->bary[k] == 0.0) t->edge[i].original = true;
   }
+}
 
-  // Planes over image pixels from the unsnapped positions: depth and
-  // barycentrics then stay those of the true triangle (what a ray caster
-  // sees) to double precision; snapping only decides coverage. Slivers
-  // whose unsnapped area vanishes fall back to the snapped positions.
-  double x[3], y[3], z[3], invW[3], dOverW[3], b1[3], b2[3];
+// The image positions the planes are made over, in v's order, and twice
+// the area they span in pixels² (positive). The unsnapped positions: depth
+// and barycentrics then stay those of the true triangle (what a ray caster
+// sees) to double precision; snapping only decides coverage. Slivers whose
+// unsnapped area vanishes fall back to the snapped positions, whose area
+// is exact in int64.
+double planePositions(const SampleGrid& grid, const TriangleSetup& t, const glm::dvec2 image[3],
+                      const int order[3], double x[3], double y[3]) {
+  const double U = double(grid.unitsPerPixel);
   for (int i = 0; i < 3; ++i) {
     x[i] = image[order[i]].x;
     y[i] = image[order[i]].y;
   }
-  double areaPixels = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-  if (!(areaPixels > 0.0) || !std::isfinite(areaPixels)) {
-    for (int i = 0; i < 3; ++i) {
-      x[i] = double(t->vertex[i].x) / U;
-      y[i] = double(t->vertex[i].y) / U;
-    }
-    // Twice the snapped area in units², positive in the reordered vertices
-    // (setupEdges): exact in int64.
-    const int64_t area2 =
-        (int64_t(t->vertex[1].x) - t->vertex[0].x) * (int64_t(t->vertex[2].y) - t->vertex[0].y) -
-        (int64_t(t->vertex[1].y) - t->vertex[0].y) * (int64_t(t->vertex[2].x) - t->vertex[0].x);
-    areaPixels = double(area2) / (U * U);
+  const double areaPixels = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+  if (areaPixels > 0.0 && std::isfinite(areaPixels)) return areaPixels;
+  for (int i = 0; i < 3; ++i) {
+    x[i] = double(t.vertex[i].x) / U;
+    y[i] = double(t.vertex[i].y) / U;
   }
+  const int64_t area2 = (int64_t(t.vertex[1].x) - t.vertex[0].x) * (int64_t(t.vertex[2].y) - t.vertex[0].y) -
+                        (int64_t(t.vertex[1].y) - t.vertex[0].y) * (int64_t(t.vertex[2].x) - t.vertex[0].x);
+  return double(area2) / (U * U);
+}
+
+// The scalar reference of setupPlanes: one division per plane
+// coefficient and per vertex attribute, in the order written.
+void setupPlanesScalar(const SampleGrid& grid, const DepthSettings& ds, const ClipVertex v[3],
+                       const glm::dvec2 image[3], const int order[3], TriangleSetup* t) {
+  const ClipVertex* cv[3];
+  markOriginalEdges(v, order, cv, t);
+
+  double x[3], y[3], z[3], invW[3], dOverW[3], b1[3], b2[3];
+  const double areaPixels = planePositions(grid, *t, image, order, x, y);
   for (int i = 0; i < 3; ++i) {
     const glm::dvec4& p = cv[i]->position;
     z[i] = windowDepth(ds.format, ds.projection, ds.znear, ds.zfar, p.z);
@@ -221,30 +231,11 @@ void setupPlanesScalar(const SampleGrid& grid, const DepthSettings& ds, const Cl
 // weights) divide nothing more.
 void setupPlanes(const SampleGrid& grid, const DepthSettings& ds, const ClipVertex v[3],
                  const glm::dvec2 image[3], const int order[3], TriangleSetup* t) {
-  const double U = double(grid.unitsPerPixel);
-  const ClipVertex* cv[3] = {&v[order[0]], &v[order[1]], &v[order[2]]};
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3;
-    for (int k = 0; k < 3; ++k)
-      if (cv[i]->bary[k] == 0.0 && cv[j]->bary[k] == 0.0) t->edge[i].original = true;
-  }
+  const ClipVertex* cv[3];
+  markOriginalEdges(v, order, cv, t);
 
   double x[3], y[3];
-  for (int i = 0; i < 3; ++i) {
-    x[i] = image[order[i]].x;
-    y[i] = image[order[i]].y;
-  }
-  double areaPixels = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-  if (!(areaPixels > 0.0) || !std::isfinite(areaPixels)) {
-    for (int i = 0; i < 3; ++i) {
-      x[i] = double(t->vertex[i].x) / U;
-      y[i] = double(t->vertex[i].y) / U;
-    }
-    const int64_t area2 =
-        (int64_t(t->vertex[1].x) - t->vertex[0].x) * (int64_t(t->vertex[2].y) - t->vertex[0].y) -
-        (int64_t(t->vertex[1].y) - t->vertex[0].y) * (int64_t(t->vertex[2].x) - t->vertex[0].x);
-    areaPixels = double(area2) / (U * U);
-  }
+  const double areaPixels = planePositions(grid, *t, image, order, x, y);
   // attr[0] = z, attr[1] = 1/w, attr[2] = d/w, attr[3] = b1/w, attr[4] = b2/w.
   double attr[5][3];
   Double2 perVertex[3];  // (1, 1), (1, d0), (d1, d2) over (w0, w1), (w2, w0), (w1, w2)
