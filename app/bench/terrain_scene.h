@@ -8,10 +8,13 @@
 // the same number of pixels (pixels / triangles), nearly all triangles are
 // in view, and every tessellation shows the same picture: scenes of one
 // aspect ratio differ only in their triangle count. The bumps' slopes (up to
-// 37°) hide some of the surface at the far edge and cast shadows under the
-// light, so neither visibility nor shading is trivial.
-// In the bench library: `rastray bench terrain:N` renders them, and the
-// crossover study (app/studies/sweep_crossover.h) sweeps their sizes.
+// 37°) hide some of the surface at the far edge and, lit, cast shadows under
+// the directional light. Unlit, the surface is emissive (one flat colour:
+// the picture is uniform, the work is visibility, set-up and per-sample
+// shading without lights).
+// In the bench library: `rastray bench terrain:N` renders the unlit one (so
+// do the peers in bench/peers/table.sh), and the crossover study
+// (app/studies/sweep_crossover.h) sweeps their sizes.
 #pragma once
 
 #include <cstdint>
