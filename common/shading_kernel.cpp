@@ -253,50 +253,58 @@ void LanesNormals(LaneBlock* b, bool eyeLight) {
   }
 }
 
+// One light's E·cosθ for lanes i.. with lighting normal n (0 where it does
+// not reach a lane): from the vector to the light vx/vy/vz + i (point, spot)
+// or the light's direction (directional, where vx/vy/vz are not read). One
+// function for both lane paths: their bits must agree.
+template <class D>
+HWY_INLINE hn::Vec<D> LightWeight(D d, const LaneLight& light, const float* vxs, const float* vys,
+                                  const float* vzs, size_t i, hn::Vec<D> nx, hn::Vec<D> ny, hn::Vec<D> nz) {
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f);
+  auto lx = hn::Set(d, light.dirX), ly = hn::Set(d, light.dirY), lz = hn::Set(d, light.dirZ);
+  auto irradiance = hn::Set(d, light.intensity);
+  auto reaches = hn::Eq(zero, zero);
+  if (light.type != 2) {
+    const auto vx = hn::Load(d, vxs + i), vy = hn::Load(d, vys + i), vz = hn::Load(d, vzs + i);
+    const auto distance = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), hn::Mul(vz, vz)));
+    reaches = hn::Gt(distance, zero);
+    lx = hn::Div(vx, distance);
+    ly = hn::Div(vy, distance);
+    lz = hn::Div(vz, distance);
+    // I / d², as two divisions: d² alone would overflow float sooner.
+    irradiance = hn::Div(hn::Div(irradiance, distance), distance);
+    if (light.range > 0.0f) {
+      // glTF's range window: clamp(1 − (d / range)⁴, 0, 1).
+      const auto r = hn::Div(distance, hn::Set(d, light.range));
+      const auto r2 = hn::Mul(r, r);
+      irradiance = hn::Mul(irradiance, hn::Min(hn::Max(hn::Sub(one, hn::Mul(r2, r2)), zero), one));
+    }
+    if (light.type == 1) {
+      // The cone: cd = spot·(−l), t = clamp((cd − cos outer) / denominator, 0, 1), weight t².
+      const auto cd =
+          hn::Neg(hn::Add(hn::Add(hn::Mul(hn::Set(d, light.spotX), lx), hn::Mul(hn::Set(d, light.spotY), ly)),
+                          hn::Mul(hn::Set(d, light.spotZ), lz)));
+      const auto t = hn::Min(
+          hn::Max(hn::Div(hn::Sub(cd, hn::Set(d, light.cosOuter)), hn::Set(d, light.coneDenominator)), zero),
+          one);
+      irradiance = hn::Mul(irradiance, hn::Mul(t, t));
+    }
+  }
+  const auto cosine = hn::Add(hn::Add(hn::Mul(nx, lx), hn::Mul(ny, ly)), hn::Mul(nz, lz));
+  reaches = hn::And(reaches, hn::And(hn::Gt(cosine, zero), hn::Gt(irradiance, zero)));
+  return hn::IfThenElseZero(reaches, hn::Mul(irradiance, cosine));
+}
+
 // One light's E·cosθ per lane (0 where it does not reach the lane), from
 // toLight* (point, spot: the vector from the surface to the light) or the
 // light's direction (directional).
 void LanesLightWeight(LaneBlock* b, const LaneLight& light) {
   const hn::ScalableTag<float> d;
   const size_t N = hn::Lanes(d);
-  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f);
   for (size_t i = 0; i < b->lanes; i += N) {
-    auto lx = hn::Set(d, light.dirX), ly = hn::Set(d, light.dirY), lz = hn::Set(d, light.dirZ);
-    auto irradiance = hn::Set(d, light.intensity);
-    auto reaches = hn::Eq(zero, zero);
-    if (light.type != 2) {
-      const auto vx = hn::Load(d, b->toLightX + i), vy = hn::Load(d, b->toLightY + i),
-                 vz = hn::Load(d, b->toLightZ + i);
-      const auto distance = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), hn::Mul(vz, vz)));
-      reaches = hn::Gt(distance, zero);
-      lx = hn::Div(vx, distance);
-      ly = hn::Div(vy, distance);
-      lz = hn::Div(vz, distance);
-      // I / d², as two divisions: d² alone would overflow float sooner.
-      irradiance = hn::Div(hn::Div(irradiance, distance), distance);
-      if (light.range > 0.0f) {
-        // glTF's range window: clamp(1 − (d / range)⁴, 0, 1).
-        const auto r = hn::Div(distance, hn::Set(d, light.range));
-        const auto r2 = hn::Mul(r, r);
-        irradiance = hn::Mul(irradiance, hn::Min(hn::Max(hn::Sub(one, hn::Mul(r2, r2)), zero), one));
-      }
-      if (light.type == 1) {
-        // The cone: cd = spot·(−l), t = clamp((cd − cos outer) / denominator, 0, 1), weight t².
-        const auto cd = hn::Neg(
-            hn::Add(hn::Add(hn::Mul(hn::Set(d, light.spotX), lx), hn::Mul(hn::Set(d, light.spotY), ly)),
-                    hn::Mul(hn::Set(d, light.spotZ), lz)));
-        const auto t = hn::Min(
-            hn::Max(hn::Div(hn::Sub(cd, hn::Set(d, light.cosOuter)), hn::Set(d, light.coneDenominator)),
-                    zero),
-            one);
-        irradiance = hn::Mul(irradiance, hn::Mul(t, t));
-      }
-    }
-    const auto cosine =
-        hn::Add(hn::Add(hn::Mul(hn::Load(d, b->nX + i), lx), hn::Mul(hn::Load(d, b->nY + i), ly)),
-                hn::Mul(hn::Load(d, b->nZ + i), lz));
-    reaches = hn::And(reaches, hn::And(hn::Gt(cosine, zero), hn::Gt(irradiance, zero)));
-    hn::Store(hn::IfThenElseZero(reaches, hn::Mul(irradiance, cosine)), d, b->weight + i);
+    const auto w = LightWeight(d, light, b->toLightX, b->toLightY, b->toLightZ, i, hn::Load(d, b->nX + i),
+                               hn::Load(d, b->nY + i), hn::Load(d, b->nZ + i));
+    hn::Store(w, d, b->weight + i);
   }
 }
 
@@ -398,7 +406,7 @@ void LanesLightsFinish(LaneBlock* b, const LaneInputs* in, const LaneLight* ligh
                        bool eyeLight) {
   const hn::ScalableTag<float> df;
   const size_t N = hn::Lanes(df);
-  const auto zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+  const auto zero = hn::Zero(df);
   const auto invPi = hn::Set(df, eyeLight ? 1.0f : float(0.31830988618379067154));
   const bool perLane = b->colourPerLane;
   for (size_t i = 0; i < b->lanes; i += N) {
@@ -417,37 +425,7 @@ void LanesLightsFinish(LaneBlock* b, const LaneInputs* in, const LaneLight* ligh
       for (size_t l = 0; l < lightCount; ++l) {
         const LaneLight& light = lights[l];
         // LanesLightWeight.
-        auto lx = hn::Set(df, light.dirX), ly = hn::Set(df, light.dirY), lz = hn::Set(df, light.dirZ);
-        auto irradiance = hn::Set(df, light.intensity);
-        auto reaches = hn::Eq(zero, zero);
-        if (light.type != 2) {
-          const auto vx = hn::Load(df, b->lightX[l] + i), vy = hn::Load(df, b->lightY[l] + i),
-                     vz = hn::Load(df, b->lightZ[l] + i);
-          const auto distance = hn::Sqrt(hn::Add(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), hn::Mul(vz, vz)));
-          reaches = hn::Gt(distance, zero);
-          lx = hn::Div(vx, distance);
-          ly = hn::Div(vy, distance);
-          lz = hn::Div(vz, distance);
-          irradiance = hn::Div(hn::Div(irradiance, distance), distance);
-          if (light.range > 0.0f) {
-            const auto r = hn::Div(distance, hn::Set(df, light.range));
-            const auto r2 = hn::Mul(r, r);
-            irradiance = hn::Mul(irradiance, hn::Min(hn::Max(hn::Sub(one, hn::Mul(r2, r2)), zero), one));
-          }
-          if (light.type == 1) {
-            const auto cd = hn::Neg(
-                hn::Add(hn::Add(hn::Mul(hn::Set(df, light.spotX), lx), hn::Mul(hn::Set(df, light.spotY), ly)),
-                        hn::Mul(hn::Set(df, light.spotZ), lz)));
-            const auto t = hn::Min(
-                hn::Max(hn::Div(hn::Sub(cd, hn::Set(df, light.cosOuter)), hn::Set(df, light.coneDenominator)),
-                        zero),
-                one);
-            irradiance = hn::Mul(irradiance, hn::Mul(t, t));
-          }
-        }
-        const auto cosine = hn::Add(hn::Add(hn::Mul(nx, lx), hn::Mul(ny, ly)), hn::Mul(nz, lz));
-        reaches = hn::And(reaches, hn::And(hn::Gt(cosine, zero), hn::Gt(irradiance, zero)));
-        const auto w = hn::IfThenElseZero(reaches, hn::Mul(irradiance, cosine));
+        const auto w = LightWeight(df, light, b->lightX[l], b->lightY[l], b->lightZ[l], i, nx, ny, nz);
         // LanesAccumulate without visibility.
         const auto lit = hn::Gt(w, zero);
         sumR = hn::Add(sumR, hn::IfThenElseZero(lit, hn::Mul(hn::Set(df, light.colorR), w)));
