@@ -70,6 +70,28 @@ inline void floatRowKeys(bool reversed, const double (&column)[8], double row, _
 }
 #endif
 
+#if defined(__SSE2__)
+// The float keys of four samples of pixel (px, py), at the positions
+// (px + qx[k], py + qy[k]), k < 4, as one vector (lane k: sample k):
+// Plane::at's operations per lane in its order, (v0 + dx·(x − x0)) +
+// dy·(y − y0) with x = px + qx[k], then floatRowKeys' clamp, conversion
+// and reversal, so depthKey's bits (the same argument as above).
+inline __m128i pixelSampleKeys(bool reversed, const Plane& p, int px, int py, const double* qx,
+                               const double* qy) {
+  const __m128d x = _mm_set1_pd(double(px)), y = _mm_set1_pd(double(py));
+  const __m128d v0 = _mm_set1_pd(p.v0), dx = _mm_set1_pd(p.dx), dy = _mm_set1_pd(p.dy);
+  const __m128d x0 = _mm_set1_pd(p.x0), y0 = _mm_set1_pd(p.y0);
+  const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0);
+  const auto clamped = [&](int k) {
+    const __m128d u = _mm_add_pd(v0, _mm_mul_pd(dx, _mm_sub_pd(_mm_add_pd(x, _mm_loadu_pd(qx + k)), x0)));
+    const __m128d z = _mm_add_pd(u, _mm_mul_pd(dy, _mm_sub_pd(_mm_add_pd(y, _mm_loadu_pd(qy + k)), y0)));
+    return _mm_cvtpd_ps(_mm_min_pd(one, _mm_max_pd(zero, z)));  // NaN and −0 pass through, as std::clamp
+  };
+  const __m128i bits = _mm_castps_si128(_mm_movelh_ps(clamped(0), clamped(2)));
+  return reversed ? _mm_sub_epi32(_mm_set1_epi32(0x3F800000), bits) : bits;  // depthKey: kOneBits − bits
+}
+#endif
+
 // keys[i] = depthKey(format, column[i] + row), bit for bit.
 inline void planeRowKeys(DepthFormat format, const double (&column)[8], double row, uint32_t (&keys)[8]) {
 #if defined(__SSE2__)

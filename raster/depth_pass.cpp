@@ -10,7 +10,9 @@
 // lanes at float formats without an alpha test (depth_lanes.h: every
 // entry of its rows a vector at a time, the same bits, ties handed back
 // to the id rule here); other whole blocks take their keys a block row at
-// a time, eight in SIMD doubles (depth_keys.h, the same bits). In front of that, a
+// a time, eight in SIMD doubles (depth_keys.h, the same bits). Samples
+// tested from masks at 4 (8, 16) spp take a pixel's four samples as one
+// vector (pixelSampleKeys, the same bits). In front of that, a
 // hierarchical depth test per block of the rect: an upper bound of the
 // keys stored in the block against a lower bound of the triangle's keys
 // there; a block where the triangle is behind everything stored is skipped
@@ -186,6 +188,14 @@ inline bool rowLess(const uint32_t (&keys)[8], const uint32_t* stored, uint32_t*
 }
 
 #if defined(__SSE2__)
+// Lane k all ones where bit k of m (m < 16) is set, else zero.
+inline __m128i laneMask4(uint32_t m) {
+  const __m128i bits = _mm_set_epi32(8, 4, 2, 1);
+  return _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(int(m)), bits), bits);
+}
+#endif
+
+#if defined(__SSE2__)
 // The small-triangle path's coverage of rows [0, h) of its bounds at one
 // sample: r0, r1, r2 each edge's E + bias + offset at the row's first
 // pixel, stepped by s0, s1, s2 a row; col[e][v] the lanes' column terms
@@ -241,6 +251,18 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
   // and sample positions, a block row's 8·spp entries in target order.
   const bool blockLanes =
       !alphaTest && (format == DepthFormat::FloatReversed || format == DepthFormat::Float);
+#if defined(__SSE2__)
+  // A pixel's samples four a vector where the masks are tested
+  // (testMaskedSamples) at float formats without an alpha test: the
+  // samples' positions in the pixel, x and y apart.
+  const bool pixelLanes = blockLanes && spp % 4 == 0;
+  const bool reversedKeys = format == DepthFormat::FloatReversed;
+  std::vector<double> sampleX(static_cast<size_t>(spp)), sampleY(static_cast<size_t>(spp));
+  for (size_t s = 0; s < size_t(spp); ++s) {
+    sampleX[s] = grid.positions[s].x;
+    sampleY[s] = grid.positions[s].y;
+  }
+#endif
   std::vector<double> entries;
   DepthBlockLanes lanes;
   uint8_t coverBits[kCoverageBlock * 8];  // a partial block's entry bits, up to 8 spp
@@ -366,24 +388,86 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
       ++written;
       writtenMax = std::max(writtenMax, key);
     };
+#if defined(__SSE2__)
+    // The samples set in per-sample masks as testMaskedSamples below,
+    // pixel by pixel, its samples four a vector (consecutive in the
+    // target): the keys (pixelSampleKeys: sampleDepthKey's bits), the test
+    // against the stored keys and the write, masked to the covered
+    // samples. Only a vector holding a tie with a covered sample tests
+    // them one by one (the id rule; keys only: a tie fails, as key <
+    // stored says). Each covered sample is still tested once, so the
+    // order changes nothing.
+    const auto testPixelLanes = [&](int x0, int y0, const uint64_t* sampleMasks, uint32_t& written,
+                                    uint32_t& writtenMax) __attribute__((always_inline)) {
+      const __m128i signBit = _mm_set1_epi32(int(0x80000000u));
+      const __m128i setup = _mm_set1_epi32(int(index));
+      uint64_t pixels = 0;
+      for (int s = 0; s < spp; ++s) pixels |= sampleMasks[s];
+      while (pixels) {
+        const int bit = __builtin_ctzll(pixels);
+        pixels &= pixels - 1;
+        const int px = x0 + (bit & 7), py = y0 + (bit >> 3);
+        const size_t pixel = (size_t(py - targetY0) * targetWidth + size_t(px - targetX0)) * size_t(spp);
+        for (int s = 0; s < spp; s += 4) {
+          uint32_t cover = 0;
+          for (int k = 0; k < 4; ++k) cover |= uint32_t(sampleMasks[s + k] >> bit & 1u) << k;
+          if (cover == 0) continue;
+          const __m128i key =
+              pixelSampleKeys(reversedKeys, t.depth, px, py, &sampleX[size_t(s)], &sampleY[size_t(s)]);
+          uint32_t* stored = keys + pixel + size_t(s);
+          const __m128i old = _mm_loadu_si128(reinterpret_cast<const __m128i*>(stored));
+          const uint32_t ties =
+              uint32_t(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(key, old)))) & cover;
+          if (ties != 0 && !keysOnly) {
+            alignas(16) uint32_t sampleKeys[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(sampleKeys), key);
+            for (int k = 0; k < 4; ++k)
+              if (cover >> k & 1u) testKey(px, py, s + k, sampleKeys[k], written, writtenMax);
+            continue;
+          }
+          // Unsigned key < stored as signed (key ^ 2^31) < (stored ^ 2^31).
+          const __m128i less = _mm_cmplt_epi32(_mm_xor_si128(key, signBit), _mm_xor_si128(old, signBit));
+          const uint32_t pass = uint32_t(_mm_movemask_ps(_mm_castsi128_ps(less))) & cover;
+          if (pass == 0) continue;
+          const __m128i write = laneMask4(pass);
+          _mm_storeu_si128(reinterpret_cast<__m128i*>(stored),
+                           _mm_or_si128(_mm_and_si128(write, key), _mm_andnot_si128(write, old)));
+          if (!keysOnly) {
+            __m128i* winner = reinterpret_cast<__m128i*>(winners + pixel + size_t(s));
+            _mm_storeu_si128(winner, _mm_or_si128(_mm_and_si128(write, setup),
+                                                  _mm_andnot_si128(write, _mm_loadu_si128(winner))));
+          }
+          const uint32_t passed = uint32_t(bitCount(pass));
+          counters->samplesPassed += passed;
+          written += passed;
+        }
+      }
+    };
+#endif
     // The samples of one block set in its per-sample masks (bit 8·y + x
-    // from the block's corner x0, y0), tested sample by sample in bit
-    // order; the block's hierarchical bound learns what was written.
+    // from the block's corner x0, y0), tested a pixel's four samples at
+    // once where pixelLanes allows, else sample by sample in bit order;
+    // the block's hierarchical bound learns what was written.
     const auto testMaskedSamples = [&](int x0, int y0, const uint64_t* sampleMasks, size_t hb)
         __attribute__((always_inline)) {
       uint32_t written = 0, writtenMax = 0;
       int tested = 0;
-      for (int s = 0; s < spp; ++s) {
-        uint64_t m = sampleMasks[s];
-        tested += bitCount(m);
-        const glm::dvec2 q = grid.positions[size_t(s)];
-        while (m) {
-          const int bit = __builtin_ctzll(m);
-          m &= m - 1;
-          const int px = x0 + (bit & 7), py = y0 + (bit >> 3);
-          // sampleDepthKey's operations (the position px + q.x, py + q.y).
-          testKey(px, py, s, depthKey(format, t.depth.at(double(px) + q.x, double(py) + q.y)), written,
-                  writtenMax);
+      for (int s = 0; s < spp; ++s) tested += bitCount(sampleMasks[s]);
+#if defined(__SSE2__)
+      if (pixelLanes) {
+        testPixelLanes(x0, y0, sampleMasks, written, writtenMax);
+      } else
+#endif
+      {
+        for (int s = 0; s < spp; ++s) {
+          const glm::dvec2 q = grid.positions[size_t(s)];
+          for (uint64_t m = sampleMasks[s]; m; m &= m - 1) {
+            const int bit = __builtin_ctzll(m);
+            const int px = x0 + (bit & 7), py = y0 + (bit >> 3);
+            // sampleDepthKey's operations (the position px + q.x, py + q.y).
+            testKey(px, py, s, depthKey(format, t.depth.at(double(px) + q.x, double(py) + q.y)), written,
+                    writtenMax);
+          }
         }
       }
       counters->samplesTested += uint64_t(tested);
