@@ -278,10 +278,10 @@ void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count,
 
 // What the camera pass asks of setup besides the setups: planes[i] =
 // refinePlaneReference(scene, setups[i].instance, setups[i].triangle, eye)
-// for every setup, computed in lanes in parallel blocks once the setups
-// are in place and written in place, so the fused pass reads one entry per
-// run of samples instead of sorting corners on a cache miss. Storage
-// reused as for the setups.
+// for every setup, computed in lanes by the pipeline's parallel stage on
+// each chunk's setups while they are in cache, and appended with them, so
+// the fused pass reads one entry per run of samples instead of sorting
+// corners on a cache miss. Storage reused as for the setups.
 struct RefinePlaneRequest {
   glm::dvec3 eye{0.0};
   RefinePlanes* planes = nullptr;
