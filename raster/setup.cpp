@@ -577,8 +577,7 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
     if (!anyDegenerate) loadPositions(c.scene, idx, p);
     const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
     t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
-    t.corners = idx;
-    t.faceNormal = faceNormalOfCorners(p[0], p[1], p[2]);
+    t.corners = idx;  // faceNormal: the chunk's, in lanes below
     const ClipVertex v[3] = {
         {clip[0], glm::dvec3(1, 0, 0)}, {clip[1], glm::dvec3(0, 1, 0)}, {clip[2], glm::dvec3(0, 0, 1)}};
     const glm::dvec2 image[3] = {c.space.imageOf(clip[0]), c.space.imageOf(clip[1]),
@@ -586,6 +585,8 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
     setupPlanes(c.grid, c.depth, v, image, order, &t);
     out->setups.push_back(t);
   }
+  // Every setup's (clipped pieces' again: the same bits).
+  faceNormals(c.scene, out->setups.data(), out->setups.size());
 }
 
 // Fills `codes` for every vertex of the instances the chunks cover, in
