@@ -380,6 +380,7 @@ struct SetupChunk {
 struct ChunkOutput {
   uint32_t inputs = 0;  // the chunk's triangles
   std::vector<TriangleSetup> setups;
+  RefinePlanes planes;  // one per setup when the frame asks for them
   SetupCounters counters;
 };
 
@@ -576,8 +577,7 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
     if (!anyDegenerate) loadPositions(c.scene, idx, p);
     const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
     t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
-    t.corners = idx;
-    t.faceNormal = faceNormalOfCorners(p[0], p[1], p[2]);
+    t.corners = idx;  // faceNormal: the chunk's, in lanes below
     const ClipVertex v[3] = {
         {clip[0], glm::dvec3(1, 0, 0)}, {clip[1], glm::dvec3(0, 1, 0)}, {clip[2], glm::dvec3(0, 0, 1)}};
     const glm::dvec2 image[3] = {c.space.imageOf(clip[0]), c.space.imageOf(clip[1]),
@@ -585,6 +585,8 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
     setupPlanes(c.grid, c.depth, v, image, order, &t);
     out->setups.push_back(t);
   }
+  // Every setup's (clipped pieces' again: the same bits).
+  faceNormals(c.scene, out->setups.data(), out->setups.size());
 }
 
 // Fills `codes` for every vertex of the instances the chunks cover, in
@@ -618,6 +620,25 @@ void computeVertexCodes(const Scene& scene, const ClipSpace& space, const Sample
       snapped[v] = {int32_t(snapUnits(image.x, U)), int32_t(snapUnits(image.y, U))};
     }
   });
+}
+
+// The refinement planes of a chunk's setups, made in the pipeline's
+// parallel stage while the chunk's setups and corners are still in cache
+// (made after the pipeline, from the frame's array, each setup's first
+// line was a cache miss: hundreds of MB written long before).
+void chunkRefinePlanes(const Scene& scene, const glm::dvec3& eye, ChunkOutput* out) {
+  out->planes.resize(out->setups.size());  // default-initialised: written right after
+  refinePlanes(scene, out->setups.data(), out->setups.size(), eye, out->planes.data());
+}
+
+// Appends a chunk's planes: sized without writing, then one memmove
+// (RefinePlane is trivially copyable). The storage grows as the setups'
+// (`capacity`) when clipping made more setups than inputs.
+void appendPlanes(const RefinePlanes& chunk, size_t capacity, RefinePlanes* planes) {
+  if (planes->capacity() < capacity) planes->reserve(capacity);
+  const size_t at = planes->size();
+  planes->resize(at + chunk.size());
+  std::copy(chunk.begin(), chunk.end(), planes->begin() + std::ptrdiff_t(at));
 }
 
 // `*v` emptied, with capacity for n elements: fresh storage is advised
@@ -698,6 +719,7 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
       setupChunkFast(context, codes, chunks[c], out.get());
     else
       setupChunkReference(context, chunks[c], out.get());
+    if (refine.planes) chunkRefinePlanes(scene, refine.eye, out.get());
     outputs[c] = std::move(out);
     tsanRelease(&outputs[c]);
     return c;
@@ -713,6 +735,7 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
     if (setups.size() + out->setups.size() > setups.capacity())
       setups.reserve(setups.size() + out->setups.size() + (inputs - std::min(inputs, appendedInputs)));
     setups.insert(setups.end(), out->setups.begin(), out->setups.end());
+    if (refine.planes) appendPlanes(out->planes, setups.capacity(), refine.planes);
     add(out->counters, counters);
     tsanRelease(&setups);
   };
@@ -722,17 +745,6 @@ void prepareTriangles(const Scene& scene, const ClipSpace& space, const SampleGr
   edges.fork();
   tbb::parallel_pipeline(tokens, filters);
   edges.join();
-  if (!refine.planes) return;
-  // The refinement planes, written in place (sized without zeroing) in
-  // parallel blocks of setups.
-  RefinePlanes& planes = *refine.planes;
-  planes.resize(setups.size());
-  constexpr size_t kPlaneBlock = 4096;
-  parallelFor(size_t(0), (setups.size() + kPlaneBlock - 1) / kPlaneBlock, [&](size_t b) {
-    const size_t first = b * kPlaneBlock;
-    refinePlanes(scene, setups.data() + first, std::min(kPlaneBlock, setups.size() - first), refine.eye,
-                 planes.data() + first);
-  });
 }
 
 }  // namespace rastray

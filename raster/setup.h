@@ -276,12 +276,20 @@ RefinePlane refinePlaneReference(const Scene& scene, uint32_t instance, uint32_t
 void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count, const glm::dvec3& eye,
                   RefinePlane* out);
 
+// setups[i].faceNormal = faceNormalOfCorners of the positions of
+// setups[i].corners (which must be stored corners, not kNoId) for i <
+// count, bit for bit on every target: faceNormal's cross product, length
+// and divisions in Highway double lanes, a block of triangles at a time
+// (prepareTriangles' fast path, per chunk, instead of a square root and
+// three dependent divisions per triangle).
+void faceNormals(const Scene& scene, TriangleSetup* setups, size_t count);
+
 // What the camera pass asks of setup besides the setups: planes[i] =
 // refinePlaneReference(scene, setups[i].instance, setups[i].triangle, eye)
-// for every setup, computed in lanes in parallel blocks once the setups
-// are in place and written in place, so the fused pass reads one entry per
-// run of samples instead of sorting corners on a cache miss. Storage
-// reused as for the setups.
+// for every setup, computed in lanes by the pipeline's parallel stage on
+// each chunk's setups while they are in cache, and appended with them, so
+// the fused pass reads one entry per run of samples instead of sorting
+// corners on a cache miss. Storage reused as for the setups.
 struct RefinePlaneRequest {
   glm::dvec3 eye{0.0};
   RefinePlanes* planes = nullptr;

@@ -32,6 +32,13 @@ struct PlaneBlock {
   alignas(64) double e2DotQ[kBlock], slot1[kBlock], slot2[kBlock];
 };
 
+// A block of triangles' corners and their unit face normals.
+struct NormalBlock {
+  size_t lanes = 0;                    // a whole number of vectors
+  alignas(64) double c[3][3][kBlock];  // [corner][axis][lane]
+  alignas(64) double n[3][kBlock];     // [axis][lane]
+};
+
 }  // namespace setup_planes_detail
 }  // namespace rastray
 #endif  // RASTRAY_SETUP_PLANES_BLOCK_
@@ -105,6 +112,32 @@ void LanesRefinePlanes(setup_planes_detail::PlaneBlock* b, const double* eye) {
   }
 }
 
+// Per lane: faceNormal's (common/surface.cpp) n = glm::cross(p1 − p0,
+// p2 − p0), length = sqrt((n.x·n.x + n.y·n.y) + n.z·n.z) (glm::length),
+// n / length when length > 0, else (0, 0, 1). Three divisions and a
+// square root per triangle, correctly rounded in every lane.
+void LanesFaceNormals(setup_planes_detail::NormalBlock* b) {
+  const hn::ScalableTag<double> d;
+  using V = hn::Vec<decltype(d)>;
+  const size_t N = hn::Lanes(d);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    V p[3][3];
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) p[c][a] = hn::Load(d, b->c[c][a] + i);
+    const V ux = hn::Sub(p[1][0], p[0][0]), uy = hn::Sub(p[1][1], p[0][1]), uz = hn::Sub(p[1][2], p[0][2]);
+    const V vx = hn::Sub(p[2][0], p[0][0]), vy = hn::Sub(p[2][1], p[0][1]), vz = hn::Sub(p[2][2], p[0][2]);
+    const V nx = hn::Sub(hn::Mul(uy, vz), hn::Mul(vy, uz));
+    const V ny = hn::Sub(hn::Mul(uz, vx), hn::Mul(vz, ux));
+    const V nz = hn::Sub(hn::Mul(ux, vy), hn::Mul(vx, uy));
+    const V length = hn::Sqrt(hn::Add(hn::Add(hn::Mul(nx, nx), hn::Mul(ny, ny)), hn::Mul(nz, nz)));
+    const auto positive = hn::Gt(length, zero);  // false for 0 and NaN, as the reference's test
+    hn::Store(hn::IfThenElse(positive, hn::Div(nx, length), zero), d, b->n[0] + i);
+    hn::Store(hn::IfThenElse(positive, hn::Div(ny, length), zero), d, b->n[1] + i);
+    hn::Store(hn::IfThenElse(positive, hn::Div(nz, length), one), d, b->n[2] + i);
+  }
+}
+
 size_t PlaneLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 }  // namespace HWY_NAMESPACE
@@ -120,6 +153,7 @@ HWY_AFTER_NAMESPACE();
 namespace rastray {
 
 HWY_EXPORT(LanesRefinePlanes);
+HWY_EXPORT(LanesFaceNormals);
 HWY_EXPORT(PlaneLanes);
 
 RefinePlane refinePlaneReference(const Scene& scene, uint32_t instance, uint32_t triangle,
@@ -172,6 +206,32 @@ void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count,
       p.slot1 = int32_t(b.slot1[k]);
       p.slot2 = int32_t(b.slot2[k]);
     }
+  }
+}
+
+void faceNormals(const Scene& scene, TriangleSetup* setups, size_t count) {
+  using setup_planes_detail::kBlock;
+  if (count == 0) return;
+  // Per thread: 6 KB, reused by every chunk the thread sets up.
+  thread_local setup_planes_detail::NormalBlock block;
+  setup_planes_detail::NormalBlock& b = block;
+  const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(PlaneLanes)();
+  for (size_t first = 0; first < count; first += kBlock) {
+    const size_t n = std::min(kBlock, count - first);
+    for (size_t k = 0; k < n; ++k) {
+      const glm::uvec3& v = setups[first + k].corners;
+      for (int c = 0; c < 3; ++c) {
+        const glm::vec3& p = scene.positions[v[c]];
+        b.c[c][0][k] = double(p.x), b.c[c][1][k] = double(p.y), b.c[c][2][k] = double(p.z);
+      }
+    }
+    // Padding: the last triangle again, never read back.
+    b.lanes = (n + vectorLanes - 1) / vectorLanes * vectorLanes;
+    for (size_t k = n; k < b.lanes; ++k)
+      for (int c = 0; c < 3; ++c)
+        for (int a = 0; a < 3; ++a) b.c[c][a][k] = b.c[c][a][n - 1];
+    HWY_DYNAMIC_DISPATCH(LanesFaceNormals)(&b);
+    for (size_t k = 0; k < n; ++k) setups[first + k].faceNormal = {b.n[0][k], b.n[1][k], b.n[2][k]};
   }
 }
 

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "common/surface.h"
+#include "common/triangle_plane.h"
 #include "raster/bin.h"
 #include "raster/clip.h"
 #include "raster/coverage.h"
@@ -278,6 +279,52 @@ TEST(SetupPaths, RefinePlanesInLanesGiveTheReferenceBitsOnEveryTarget) {
     }
     hwy::SetSupportedTargetsForTest(0);
   }
+}
+
+// The face normals in lanes against faceNormalOfCorners on random,
+// huge, tiny, zero-area (a repeated corner, collinear corners) and
+// signed-zero triangles in every corner order; blocks of 1 to 200, on
+// every target.
+TEST(SetupPaths, FaceNormalsInLanesGiveTheReferenceBitsOnEveryTarget) {
+  std::mt19937 rng(11);
+  const float few[] = {-0.0f, 0.0f, 1.0f, -1.0f, 0.5f, 3.0f};
+  std::uniform_int_distribution<int> pick(0, 5);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<glm::vec3> p;
+  for (int k = 0; k < 600; ++k) {
+    const float scale = k % 7 == 0 ? 1e18f : k % 11 == 0 ? 1e-19f : 2.0f;
+    for (int v = 0; v < 3; ++v)
+      p.push_back(k % 5 == 0 ? glm::vec3(few[pick(rng)], few[pick(rng)], few[pick(rng)])
+                             : glm::vec3(unit(rng), unit(rng), unit(rng)) * scale);
+  }
+  p.push_back({0.0f, 0.0f, 0.0f}), p.push_back({1.0f, 2.0f, 3.0f}),
+      p.push_back({2.0f, 4.0f, 6.0f});  // collinear
+  std::vector<glm::uvec3> corners;
+  for (uint32_t k = 0; k < 601; ++k)
+    for (const glm::uvec3 o :
+         {glm::uvec3(0, 1, 2), glm::uvec3(2, 1, 0), glm::uvec3(1, 2, 0), glm::uvec3(0, 0, 1)})
+      corners.push_back(glm::uvec3(3 * k) + o);
+  Scene scene;
+  test::addMesh(scene, p, {{0, 1, 2}});
+  std::shuffle(corners.begin(), corners.end(), rng);
+  std::vector<glm::dvec3> expected(corners.size());
+  for (size_t i = 0; i < corners.size(); ++i)
+    expected[i] = faceNormalOfCorners(glm::dvec3(p[corners[i].x]), glm::dvec3(p[corners[i].y]),
+                                      glm::dvec3(p[corners[i].z]));
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    SCOPED_TRACE(hwy::TargetName(target));
+    hwy::SetSupportedTargetsForTest(target);
+    for (size_t batch : {size_t(1), size_t(5), size_t(64), size_t(200)}) {
+      std::vector<TriangleSetup> setups(corners.size());
+      for (size_t i = 0; i < corners.size(); ++i) setups[i].corners = corners[i];
+      for (size_t first = 0; first < setups.size(); first += batch)
+        faceNormals(scene, &setups[first], std::min(batch, setups.size() - first));
+      for (size_t i = 0; i < setups.size(); ++i)
+        ASSERT_EQ(std::memcmp(&setups[i].faceNormal, &expected[i], sizeof expected[i]), 0)
+            << batch << " " << i << " z " << setups[i].faceNormal.z << " expected " << expected[i].z;
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
 }
 
 // prepareTriangles' planes: one per setup (clipped pieces included), each
