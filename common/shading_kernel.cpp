@@ -560,6 +560,7 @@ HWY_AFTER_NAMESPACE();
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <type_traits>
 
 #include "common/optics.h"
@@ -639,6 +640,35 @@ bool samplesTexture(const Shader& shader, const Material& m) {
   if (shader.textures().empty()) return false;
   return m.baseColorTexture >= 0 || (m.emissiveTexture >= 0 && m.emissive != glm::vec3(0.0f)) ||
          m.hasSurfaceMaps();
+}
+
+// The colour the lanes give every hit on `instance` when it depends on
+// nothing of the hit, else nothing. LanesFinish's L = e + diffuse ·
+// (albedo · (sum/π)) on the lanes' path: without a diffuse term
+// (diffuse ≤ 0 or NaN) L = e; with the eye light, sum = |n·d| is finite
+// and ≥ 0 (n and d unit: the face normal of finite corners, the ray's
+// direction), so on a black base colour albedo · (sum/π) is albedo's own
+// zero for every hit, and the same operations with sum = 0 give L's bits.
+// Lights' sums may be +inf (I/d² near a light): not constant there.
+std::optional<glm::vec4> constantColour(const Shader& shader, uint32_t instance) {
+  const Scene& scene = shader.scene();
+  const Material& m = scene.materialOf(instance);
+  if (needsScalarShade(shader, m) || samplesTexture(shader, m) || scene.instances[instance].hasColors)
+    return std::nullopt;
+  const float diffuse = (1.0f - m.mirrorWeight()) * (1.0f - m.transmission);  // enterRun's
+  const glm::vec3 albedo(m.baseColorFactor);
+  const bool eyeLight = shader.eyeLight();
+  if (diffuse > 0.0f && !(eyeLight && albedo == glm::vec3(0.0f))) return std::nullopt;
+  const float alpha = m.alphaMode == AlphaMode::Blend ? m.baseColorFactor.a : 1.0f;
+  const float invPi = eyeLight ? 1.0f : float(0.31830988618379067154);
+  const float sum = 0.0f;
+  glm::vec4 colour(0.0f, 0.0f, 0.0f, alpha);
+  for (int c = 0; c < 3; ++c) {
+    const float direct = albedo[c] * (sum * invPi);
+    const float L = diffuse > 0.0f ? m.emissive[c] + diffuse * direct : m.emissive[c];
+    colour[c] = L * alpha;
+  }
+  return colour;
 }
 
 // The footprint only where a texture is sampled: elsewhere it is unused.
@@ -1164,7 +1194,36 @@ struct PrimaryHitShader::Impl {
   uint32_t runInstance = kNoId;      // the path is a function of the material: decided once per instance
   const Material* material = nullptr;
   bool scalar = false;
+  std::optional<glm::vec4> constant;  // constantColour's
+
+  void enterInstance(uint32_t instance) {
+    if (instance == runInstance) return;
+    runInstance = instance;
+    material = &shader.scene().materialOf(instance);
+    scalar = needsScalarShade(shader, *material);
+    constant = constantColour(shader, instance);
+  }
+
+  // Writes every hit's colour when each one's instance has a constant
+  // colour; else returns false (the colours written so far are written
+  // again by the other paths).
+  bool shadeConstant(const PrimaryHitBlock& h, glm::vec4* colors) {
+    for (size_t k = 0; k < h.count; ++k) {
+      enterInstance(h.runInstance[h.run[k]]);
+      if (!constant) return false;
+      colors[h.colorIndex[k]] = *constant;
+    }
+    return true;
+  }
 };
+
+bool PrimaryHitShader::needsHitInputs() const {
+  if (impl_->reference) return true;
+  const Scene& scene = impl_->shader.scene();
+  for (uint32_t i = 0; i < scene.instances.size(); ++i)
+    if (!constantColour(impl_->shader, i)) return true;
+  return false;
+}
 
 PrimaryHitShader::PrimaryHitShader(const Shader& shader, ShadingPath path)
     : impl_(std::make_unique<Impl>(shader, path)) {}
@@ -1187,6 +1246,8 @@ void PrimaryHitShader::shade(const PrimaryHitBlock& h, glm::vec4* colors) {
     for (size_t k = 0; k < h.count; ++k) shadeHit(k);
     return;
   }
+  if (s.shadeConstant(h, colors)) return;
+  if (!h.dirX) throw std::logic_error("PrimaryHitShader: a block without hit inputs on a lit instance");
   if (h.run64 && h.runFirst) {
     if (!s.block) s.block.emplace(s.shader);
     if (s.block->shadeInPlace(h, colors)) return;
@@ -1199,12 +1260,7 @@ void PrimaryHitShader::shade(const PrimaryHitBlock& h, glm::vec4* colors) {
       for (end = first + 1; end < h.count && h.run[end] == run; ++end) {
       }
     }
-    const uint32_t instance = h.runInstance[run];
-    if (instance != s.runInstance) {
-      s.runInstance = instance;
-      s.material = &s.shader.scene().materialOf(instance);
-      s.scalar = needsScalarShade(s.shader, *s.material);
-    }
+    s.enterInstance(h.runInstance[run]);
     if (s.scalar) {
       for (size_t k = first; k < end; ++k) shadeHit(k);
       continue;

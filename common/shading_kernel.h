@@ -124,13 +124,15 @@ void shadePrimaryHits(const Shader& shader, const ShadeHit* hits, size_t count, 
 constexpr size_t kPrimaryHitBlock = 64;
 struct PrimaryHitBlock {
   size_t count = 0;
-  const int32_t* run = nullptr;                                    // per hit: its run, non-decreasing
-  const uint32_t* runInstance = nullptr;                           // per run
-  const uint32_t* runTriangle = nullptr;                           // per run
-  const double *dirX = nullptr, *dirY = nullptr, *dirZ = nullptr;  // per hit: unit, towards the surface
-  const float *b1 = nullptr, *b2 = nullptr;                        // per hit: refined
-  const double *footprintX = nullptr, *footprintY = nullptr;       // per hit: image position of the footprint
-  const uint32_t* colorIndex = nullptr;                            // per hit
+  const int32_t* run = nullptr;           // per hit: its run, non-decreasing
+  const uint32_t* runInstance = nullptr;  // per run
+  const uint32_t* runTriangle = nullptr;  // per run
+  // Per hit: the direction (unit, towards the surface) and the refined
+  // barycentrics; null when PrimaryHitShader::needsHitInputs() is false.
+  const double *dirX = nullptr, *dirY = nullptr, *dirZ = nullptr;
+  const float *b1 = nullptr, *b2 = nullptr;
+  const double *footprintX = nullptr, *footprintY = nullptr;  // per hit: image position of the footprint
+  const uint32_t* colorIndex = nullptr;                       // per hit
   // Optional: the first hit of each run (runs + 1 entries, the last one
   // `count`), so the kernel need not look for where runs change.
   size_t runs = 0;
@@ -167,6 +169,16 @@ class PrimaryHitShader {
 
   // Shades hits.count ≤ kPrimaryHitBlock hits into `colors`.
   void shade(const PrimaryHitBlock& hits, glm::vec4* colors);
+
+  // Whether shade() reads the hits' directions and barycentrics. False
+  // when every instance of the scene is shaded with one colour of its
+  // material alone on the lanes' path (no texture, vertex colours or
+  // scalar path; no diffuse term, or the eye light on a black base colour:
+  // an emissive, unlit surface): a block's colours are then its runs'
+  // instances' colours, the same bits as the lanes give (tested), and
+  // PrimaryHitBlock's per-hit inputs may be null. Not cached: ask once
+  // per tile.
+  bool needsHitInputs() const;
 
  private:
   struct Impl;

@@ -62,6 +62,8 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   PrimaryBatch batch(primaryConstants_, scene_, setups_.data(), planes_);
   batch.wantInterpolated(!lean);  // the lean form reads no front hits
   PrimaryHitShader kernel(shader_, shadingPath());
+  // An unlit, emissive scene's colours need no ray and no refined hit.
+  batch.wantShadingInputs(kernel.needsHitInputs());
   alignas(64) uint32_t localOut[kPrimaryHitBlock];  // the sample each is shaded at
   alignas(64) double footprintX[kPrimaryHitBlock],
       footprintY[kPrimaryHitBlock];  // image position of the footprint

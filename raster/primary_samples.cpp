@@ -23,6 +23,36 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 size_t SampleLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
+// The setup planes of lanes i.. of the block at their positions:
+// PlaneCoefficients::at, (v0 + dx·(x − x0)) + dy·(y − y0), with the run's
+// coefficients (a broadcast or a gather, RunLanes).
+template <class D>
+class PlanesAt {
+ public:
+  PlanesAt(D d, const primary_detail::FusedBlock* b, size_t i)
+      : get(d, b->run, i),
+        ox_(hn::Sub(hn::Load(d, b->x + i), get(b->x0))),
+        oy_(hn::Sub(hn::Load(d, b->y + i), get(b->y0))) {}
+  HWY_INLINE hn::Vec<D> operator()(const double* v0, const double* dx, const double* dy) const {
+    return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox_)), hn::Mul(get(dy), oy_));
+  }
+  // The interpolated depth, viewDepthAt: (d/w) / (1/w).
+  HWY_INLINE hn::Vec<D> depth(const primary_detail::FusedBlock* b) const {
+    return hn::Div((*this)(b->dw0, b->dwx, b->dwy), (*this)(b->iw0, b->iwx, b->iwy));
+  }
+  // The interpolated barycentrics, baryAt: (b/w) · (1 / (1/w)).
+  HWY_INLINE void bary(const primary_detail::FusedBlock* b, hn::Vec<D>* b1, hn::Vec<D>* b2) const {
+    const auto inv = hn::Div(hn::Set(D(), 1.0), (*this)(b->iw0, b->iwx, b->iwy));
+    *b1 = hn::Mul((*this)(b->b10, b->b1x, b->b1y), inv);
+    *b2 = hn::Mul((*this)(b->b20, b->b2x, b->b2y), inv);
+  }
+
+  const RunLanes<D> get;  // the block's other per-run tables
+
+ private:
+  hn::Vec<D> ox_, oy_;
+};
+
 // Per lane: TriangleSetup::viewDepthAt and baryAt (PlaneCoefficients::at:
 // (v0 + dx·(x − x0)) + dy·(y − y0)), then PrimaryRays::operator() for a
 // perspective camera (ndcFromImage, the view-plane vector, worldFromView's
@@ -43,20 +73,14 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
   const auto cx = hn::Set(d, c->constantPart.x), cy = hn::Set(d, c->constantPart.y);
   const auto cz = hn::Set(d, c->constantPart.z);
   for (size_t i = 0; i < b->lanes; i += N) {
-    const RunLanes<decltype(d)> get(d, b->run, i);  // per-run values: a broadcast or a gather
-    const auto x = hn::Load(d, b->x + i), y = hn::Load(d, b->y + i);
-    const auto ox = hn::Sub(x, get(b->x0)), oy = hn::Sub(y, get(b->y0));
-    const auto plane = [&](const double* v0, const double* dx, const double* dy) RASTRAY_LAMBDA_INLINE {
-      return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox)), hn::Mul(get(dy), oy));
-    };
-    const auto invW = plane(b->iw0, b->iwx, b->iwy);
-    hn::Store(hn::DemoteTo(df, hn::Div(plane(b->dw0, b->dwx, b->dwy), invW)), df, b->depth + i);
+    hn::Store(hn::DemoteTo(df, PlanesAt<decltype(d)>(d, b, i).depth(b)), df, b->depth + i);
 
     hn::Vec<decltype(d)> vx, vy;
     if (b->haveView) {
       vx = hn::Load(d, b->vx + i);
       vy = hn::Load(d, b->vy + i);
     } else {
+      const auto x = hn::Load(d, b->x + i), y = hn::Load(d, b->y + i);
       const auto ndcX = hn::Sub(hn::Div(hn::Mul(two, x), width), one);
       const auto ndcY = hn::Sub(one, hn::Div(hn::Mul(two, y), height));
       vx = hn::Mul(ndcX, sx);
@@ -95,15 +119,8 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     const auto ok = RefineOnPlane(d, dirX, dirY, dirZ, one, pl, &rb1, &rb2);
     // The interpolated barycentrics (a division) only where they are read.
     if (b->wantInterpolated || !hn::AllTrue(d, ok)) {
-      const auto x = hn::Load(d, b->x + i), y = hn::Load(d, b->y + i);
-      const auto ox = hn::Sub(x, get(b->x0)), oy = hn::Sub(y, get(b->y0));
-      const auto plane = [&](const double* v0, const double* dx, const double* dy) RASTRAY_LAMBDA_INLINE {
-        return hn::Add(hn::Add(get(v0), hn::Mul(get(dx), ox)), hn::Mul(get(dy), oy));
-      };
-      const auto invW = plane(b->iw0, b->iwx, b->iwy);
-      const auto inv = hn::Div(one, invW);
-      const auto b1 = hn::Mul(plane(b->b10, b->b1x, b->b1y), inv);
-      const auto b2 = hn::Mul(plane(b->b20, b->b2x, b->b2y), inv);
+      hn::Vec<decltype(d)> b1, b2;
+      PlanesAt<decltype(d)>(d, b, i).bary(b, &b1, &b2);
       hn::Store(b1, d, b->b1 + i);
       hn::Store(b2, d, b->b2 + i);
       rb1 = hn::IfThenElse(ok, rb1, b1);
@@ -111,6 +128,24 @@ void LanesFusedPrimary(primary_detail::FusedBlock* b, const PrimaryRayConstants*
     }
     hn::Store(hn::DemoteTo(df, rb1), df, b->kb1 + i);
     hn::Store(hn::DemoteTo(df, rb2), df, b->kb2 + i);
+  }
+}
+
+// LanesFusedPrimary's interpolation alone, for a block whose kernel reads
+// no ray or refined hit (FusedBlock::wantShadingInputs false): the depth
+// and, when wanted, the interpolated barycentrics, with its operations.
+void LanesInterpolated(primary_detail::FusedBlock* b) {
+  const hn::ScalableTag<double> d;
+  const hn::Rebind<float, decltype(d)> df;
+  const size_t N = hn::Lanes(d);
+  for (size_t i = 0; i < b->lanes; i += N) {
+    const PlanesAt<decltype(d)> at(d, b, i);
+    hn::Store(hn::DemoteTo(df, at.depth(b)), df, b->depth + i);
+    if (!b->wantInterpolated) continue;
+    hn::Vec<decltype(d)> b1, b2;
+    at.bary(b, &b1, &b2);
+    hn::Store(b1, d, b->b1 + i);
+    hn::Store(b2, d, b->b2 + i);
   }
 }
 
@@ -180,6 +215,7 @@ namespace rastray {
 
 HWY_EXPORT(SampleLanes);
 HWY_EXPORT(LanesFusedPrimary);
+HWY_EXPORT(LanesInterpolated);
 HWY_EXPORT(LanesSpanEnd);
 HWY_EXPORT(LanesFillSpan);
 
@@ -332,6 +368,7 @@ void PrimaryBatch::prefetchRun(uint32_t winner) const {
   __builtin_prefetch(t + offsetof(TriangleSetup, depth));
   __builtin_prefetch(t + offsetof(TriangleSetup, dOverW));
   __builtin_prefetch(t + offsetof(TriangleSetup, b2OverW) + sizeof(PlaneCoefficients) - 1);
+  if (!block_->wantShadingInputs) return;
   __builtin_prefetch(t + sizeof(TriangleSetup) - 1);  // corners and face normal, for the kernel
   if (refinePlanes_) {
     const char* p = reinterpret_cast<const char*>(&refinePlanes_[winner]);
@@ -340,7 +377,8 @@ void PrimaryBatch::prefetchRun(uint32_t winner) const {
   }
 }
 
-// Run r: its setup's planes and its stored triangle's plane.
+// Run r: its setup's planes and, for the kernel's inputs, its stored
+// triangle's plane, corners and face normal.
 void PrimaryBatch::fillRun(size_t r, uint32_t winner, size_t firstLane) {
   primary_detail::FusedBlock& b = *block_;
   const TriangleSetup& t = setups_[winner];
@@ -348,13 +386,23 @@ void PrimaryBatch::fillRun(size_t r, uint32_t winner, size_t firstLane) {
   b.x0[r] = t.depth.x0, b.y0[r] = t.depth.y0;
   b.iw0[r] = t.invW.v0, b.iwx[r] = t.invW.dx, b.iwy[r] = t.invW.dy;
   b.dw0[r] = t.dOverW.v0, b.dwx[r] = t.dOverW.dx, b.dwy[r] = t.dOverW.dy;
-  b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
-  b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
   runFirst_[r] = uint32_t(firstLane);
   runInstance_[r] = t.instance;
   runTriangle_[r] = t.triangle;
+  // The barycentric planes: the interpolated ones, and the refinement's
+  // fallback where it fails.
+  if (b.wantInterpolated || b.wantShadingInputs) {
+    b.b10[r] = t.b1OverW.v0, b.b1x[r] = t.b1OverW.dx, b.b1y[r] = t.b1OverW.dy;
+    b.b20[r] = t.b2OverW.v0, b.b2x[r] = t.b2OverW.dx, b.b2y[r] = t.b2OverW.dy;
+  }
+  if (!b.wantShadingInputs) return;
   runCorners_[r] = t.corners;
   runFaceNormal_[r] = t.faceNormal;
+  fillRefinePlane(r, t, winner);
+}
+
+void PrimaryBatch::fillRefinePlane(size_t r, const TriangleSetup& t, uint32_t winner) {
+  primary_detail::FusedBlock& b = *block_;
   if (refinePlanes_) {
     // Computed in setup (raster/setup.h: RefinePlane).
     const RefinePlane& p = refinePlanes_[winner];
@@ -402,7 +450,10 @@ void PrimaryBatch::run() {
       b.x[k] = b.y[k] = 0.0;
       b.run[k] = int64_t(runs_ - 1);
     }
-    HWY_DYNAMIC_DISPATCH(LanesFusedPrimary)(&b, &camera_);
+    if (b.wantShadingInputs)
+      HWY_DYNAMIC_DISPATCH(LanesFusedPrimary)(&b, &camera_);
+    else
+      HWY_DYNAMIC_DISPATCH(LanesInterpolated)(&b);
     return;
   }
   // Orthographic rays: the reference steps, then the batched refinement.
@@ -433,10 +484,21 @@ void PrimaryBatch::run() {
 PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footprintY,
                                    const uint32_t* colorIndex) {
   runFirst_[runs_] = uint32_t(used_);
+  primary_detail::FusedBlock& b = *block_;
+  PrimaryHitBlock h;
+  h.runs = runs_;
+  h.runFirst = runFirst_;
+  h.count = used_;
+  h.run = block_->run32;
+  h.runInstance = runInstance_;
+  h.runTriangle = runTriangle_;
+  h.footprintX = footprintX;
+  h.footprintY = footprintY;
+  h.colorIndex = colorIndex;
+  if (!b.wantShadingInputs) return h;
   // The kernel reads the per-hit inputs in place: lanes up to a multiple
   // of 16 (every target's float lane count divides it) hold a copy of the
   // last hit.
-  primary_detail::FusedBlock& b = *block_;
   const size_t lanes = std::min(primary_detail::kBlock, (used_ + 15) / 16 * 16);
   if (used_ > 0) {
     const size_t last = used_ - 1;
@@ -447,25 +509,15 @@ PrimaryHitBlock PrimaryBatch::hits(const double* footprintX, const double* footp
       b.kb1[k] = b.kb1[last], b.kb2[k] = b.kb2[last];
     }
   }
-  PrimaryHitBlock h;
   h.run64 = b.run;
   h.lanes = lanes;
-  h.runs = runs_;
-  h.runFirst = runFirst_;
-  h.count = used_;
-  h.run = block_->run32;
-  h.runInstance = runInstance_;
-  h.runTriangle = runTriangle_;
   h.runCorners = runCorners_;
   h.runFaceNormal = runFaceNormal_;
-  h.dirX = block_->dirX;
-  h.dirY = block_->dirY;
-  h.dirZ = block_->dirZ;
-  h.b1 = block_->kb1;
-  h.b2 = block_->kb2;
-  h.footprintX = footprintX;
-  h.footprintY = footprintY;
-  h.colorIndex = colorIndex;
+  h.dirX = b.dirX;
+  h.dirY = b.dirY;
+  h.dirZ = b.dirZ;
+  h.b1 = b.kb1;
+  h.b2 = b.kb2;
   return h;
 }
 

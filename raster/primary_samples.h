@@ -89,6 +89,11 @@ struct FusedBlock {
   // Whether the interpolated barycentrics are wanted (PrimaryBatch::hit);
   // else the lanes compute them only where the refinement fails.
   bool wantInterpolated = true;
+  // Whether the kernel's inputs are wanted (PrimaryBatch::wantShadingInputs):
+  // else the per-run refinement planes are not filled and the lanes
+  // compute the interpolation alone (the depth, and the interpolated
+  // barycentrics when wanted).
+  bool wantShadingInputs = true;
   // Out, per lane: the interpolated depth (as a float), the ray's
   // direction, the barycentrics the kernel shades with (float: the refined
   // ones where the refinement succeeds, else the interpolated ones) and,
@@ -160,10 +165,18 @@ class PrimaryBatch {
   // Whether hit(k) is read (its interpolated barycentrics are computed);
   // true until set.
   void wantInterpolated(bool want) { block_->wantInterpolated = want; }
+  // Whether the kernel reads the hits' directions and refined barycentrics
+  // (PrimaryHitShader::needsHitInputs); true until set. Without them the
+  // batch reads and computes the interpolation alone (no ray, no
+  // refinement plane, no corners or face normal), and hits() hands the
+  // kernel the runs' ids only. Set before adding samples.
+  void wantShadingInputs(bool want) { block_->wantShadingInputs = want; }
   // The refined hits for the kernel; footprints and colour indices are the
   // caller's (per sample, in the order added). The per-hit inputs are the
   // block's own, padded for the kernel to read in place
-  // (PrimaryHitBlock::run64, lanes).
+  // (PrimaryHitBlock::run64, lanes); without shading inputs
+  // (wantShadingInputs(false)) they, the corners and the face normals are
+  // null.
   PrimaryHitBlock hits(const double* footprintX, const double* footprintY, const uint32_t* colorIndex);
   void clear() {
     used_ = 0;
@@ -172,9 +185,10 @@ class PrimaryBatch {
   }
 
  private:
-  void fillRun(size_t r, uint32_t winner, size_t firstLane);  // run r's table entry
-  void prefetchRun(uint32_t winner) const;                    // what fillRun will read for it
-  static constexpr size_t kRunPrefetch = 8;                   // samples ahead in addRow
+  void fillRun(size_t r, uint32_t winner, size_t firstLane);                // run r's table entry
+  void fillRefinePlane(size_t r, const TriangleSetup& t, uint32_t winner);  // its stored triangle's plane
+  void prefetchRun(uint32_t winner) const;                                  // what fillRun will read for it
+  static constexpr size_t kRunPrefetch = 8;                                 // samples ahead in addRow
 
   const PrimaryRayConstants& camera_;
   const Scene& scene_;

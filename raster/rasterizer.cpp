@@ -13,6 +13,7 @@
 #include "common/error.h"
 #include "common/interrupt.h"
 #include "common/parallel.h"
+#include "common/shading_kernel.h"
 #include "raster/bin.h"
 #include "raster/clip.h"
 #include "raster/frame_buffers.h"
@@ -97,6 +98,10 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   const DepthSettings depth{options.depthFormat, camera.projection,           camera.znear,
                             camera.zfar,         options.polygonOffsetFactor, options.polygonOffsetUnits};
 
+  // The frame's shading, without its lights' visibility (prepared after
+  // setup, below).
+  const Shader shading(scene, analysis, camera, options.shading, nullptr, secondary);
+
   // Transform, clip, set up.
   auto start = Clock::now();
   SetupCounters sc;
@@ -112,9 +117,12 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   std::vector<TriangleSetup>& setupStorage = buffers.setups();
   // The camera pass's refinement planes (raster/setup.h: RefinePlane),
   // computed in lanes while setup has the corners in cache. A perspective
-  // camera only: the orthographic path refines with the scalar steps.
+  // camera only: the orthographic path refines with the scalar steps. Not
+  // where the kernel reads no refined hit (an unlit, emissive scene:
+  // PrimaryHitShader::needsHitInputs).
   RefinePlanes& planeStorage = buffers.planes();
-  const bool storedPlanes = camera.projection == Projection::Perspective;
+  const bool storedPlanes = camera.projection == Projection::Perspective &&
+                            PrimaryHitShader(shading, ShadingPath::Kernel).needsHitInputs();
   prepareTriangles(scene, space, grid, depth, options.cull, filter, &sc, SetupPath::Fast, &setupStorage,
                    {camera.eye(), storedPlanes ? &planeStorage : nullptr});
   const std::vector<TriangleSetup>& setups = setupStorage;
@@ -133,7 +141,7 @@ RenderOutput renderRasterWithHits(const Scene& scene, const SceneAnalysis& analy
   out.timings.emplace_back("raster.bin", secondsSince(start));
 
   const LightSetup lights = prepareLights(scene, analysis, camera, options, visibility, &out);
-  const Shader shader(scene, analysis, camera, options.shading, lights.visibility, secondary);
+  const Shader shader(shading, lights.visibility, secondary);
   describeCameraPasses(analysis, options, secondary != nullptr, &out);
 
   // Every tile: pass 1, shading, pass 2, compositing, resolve.

@@ -360,6 +360,10 @@ struct HitColumns {
   }
 };
 
+// PrimaryHitShader's blocks of runs give shadePrimaryHits' bits: lights,
+// a visibility callback, vertex colours and BLEND, the eye light, and
+// instances of one colour (constantColour: no lanes; on an all-emissive
+// scene without the per-hit inputs), on every target.
 TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
   const TintedVisibility tinted;
   Scene base = loadScene(std::string(RASTRAY_SCENES) + "/cornell-box.gltf");
@@ -377,6 +381,27 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
   mixed.instances.back().material = uint32_t(mixed.materials.size() - 1);
   Scene eyeLit = base;
   eyeLit.lights.clear();
+  // Instances shaded with one colour of their material (constantColour):
+  // emissive on a black base colour (some zeros negative) under the eye
+  // light, on every instance or every other one; no diffuse term
+  // (transmission 1) under the lights, on every other instance.
+  const auto constantEvery = [](Scene scene, size_t every, bool black) {
+    for (size_t i = 0; i < scene.instances.size(); i += every) {
+      Material m = scene.materialOf(uint32_t(i));
+      // −0 emission plus a +0 direct term is +0: the lanes' sum, not e alone.
+      m.emissive = glm::vec3(i % 7 == 0 ? -0.0f : 0.1f * float(i % 7), 0.8f, 0.5f - 0.05f * float(i));
+      if (black)
+        m.baseColorFactor =
+            i % 3 == 1 ? glm::vec4(-0.0f, 0.0f, -0.0f, 1.0f) : glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+      else
+        m.transmission = 1.0f;
+      scene.materials.push_back(m);
+      scene.instances[i].material = uint32_t(scene.materials.size() - 1);
+    }
+    return scene;
+  };
+  const Scene emissive = constantEvery(eyeLit, 1, true), someEmissive = constantEvery(eyeLit, 2, true),
+              noDiffuse = constantEvery(base, 2, false);
   struct Case {
     const char* name;
     const Scene* scene;
@@ -384,7 +409,9 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
   };
   for (const Case& c :
        {Case{"plain", &base, nullptr}, Case{"visibility", &base, &tinted},
-        Case{"vertex colours and blend", &mixed, nullptr}, Case{"eye light", &eyeLit, nullptr}}) {
+        Case{"vertex colours and blend", &mixed, nullptr}, Case{"eye light", &eyeLit, nullptr},
+        Case{"emissive", &emissive, nullptr}, Case{"some emissive", &someEmissive, nullptr},
+        Case{"no diffuse", &noDiffuse, nullptr}}) {
     SCOPED_TRACE(c.name);
     const Scene& scene = *c.scene;
     const Camera camera = makeCamera(scene, {}, 64, 48);
@@ -393,6 +420,9 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
     const Shader shader(scene, analyzeScene(scene), camera, {}, c.visibility, nullptr);
     std::vector<glm::vec4> expected(hits.size());
     shadePrimaryHits(shader, hits.data(), hits.size(), expected.data(), ShadingPath::Kernel);
+    // Only the all-emissive scene's blocks go without per-hit inputs.
+    const bool needsInputs = PrimaryHitShader(shader, ShadingPath::Kernel).needsHitInputs();
+    ASSERT_EQ(needsInputs, c.scene != &emissive);
     // The hits as struct of arrays, their colours to the reversed order.
     const size_t n = hits.size();
     std::vector<int32_t> run(n);
@@ -436,6 +466,7 @@ TEST(ShadingKernel, BlocksOfRunsGiveTheSameBitsAsShadeHits) {
             block.runInstance = runInstance.data();
             block.runTriangle = runTriangle.data();
             columns.into(block, first);
+            if (!needsInputs) block.dirX = block.dirY = block.dirZ = nullptr, block.b1 = block.b2 = nullptr;
             block.colorIndex = withRunFirst ? &forward[first] : &colorIndex[first];
             if (withRunFirst) {
               block.runs = runInstance.size();

@@ -312,56 +312,67 @@ TEST(PrimarySamples, RowsGiveTheSameBitsAsSamplesOnEveryTarget) {
       // wantInterpolated(false), as the lean tile form runs it: the
       // interpolated barycentrics only where the refinement fails, the
       // same depth and kernel inputs.
+      // wantShadingInputs(false), as an emissive scene's tiles run it: the
+      // same interpolation and runs, no kernel inputs.
       for (int64_t target : hwy::SupportedAndGeneratedTargets())
-        for (const bool interpolated : {true, false}) {
-          SCOPED_TRACE(hwy::TargetName(target) + std::string(interpolated ? "" : " lean"));
-          hwy::SetSupportedTargetsForTest(target);
-          PrimaryBatch batch(constants, scene, setups.data());
-          batch.wantInterpolated(interpolated);
-          uint32_t localOut[kPrimaryHitBlock];
-          size_t next = 0;  // the expected sample the batch's first one is
-          const auto check = [&] {
-            batch.run();
-            const PrimaryHitBlock got = batch.hits(batch.x(), batch.y(), localOut);
-            ASSERT_EQ(got.count, batch.size());
-            for (size_t k = 0; k < got.count; ++k, ++next) {
-              ASSERT_LT(next, n);
-              const ShadeHit& e = expected[next];
-              ASSERT_EQ(localOut[k], locals[next]) << "sample " << next;
-              if (interpolated) {
-                ASSERT_TRUE(sameBits(batch.hit(k), expectedHits[next])) << "sample " << next;
-              } else {
-                const float depth = batch.depth(k);
-                ASSERT_EQ(0, std::memcmp(&expectedHits[next].depth, &depth, sizeof(float)))
-                    << "sample " << next;
+        for (const bool interpolated : {true, false})
+          for (const bool inputs : {true, false}) {
+            SCOPED_TRACE(hwy::TargetName(target) + std::string(interpolated ? "" : " lean") +
+                         std::string(inputs ? "" : " no inputs"));
+            hwy::SetSupportedTargetsForTest(target);
+            PrimaryBatch batch(constants, scene, setups.data());
+            batch.wantInterpolated(interpolated);
+            batch.wantShadingInputs(inputs);
+            uint32_t localOut[kPrimaryHitBlock];
+            size_t next = 0;  // the expected sample the batch's first one is
+            const auto check = [&] {
+              batch.run();
+              const PrimaryHitBlock got = batch.hits(batch.x(), batch.y(), localOut);
+              ASSERT_EQ(got.count, batch.size());
+              for (size_t k = 0; k < got.count; ++k, ++next) {
+                ASSERT_LT(next, n);
+                const ShadeHit& e = expected[next];
+                ASSERT_EQ(localOut[k], locals[next]) << "sample " << next;
+                if (interpolated) {
+                  ASSERT_TRUE(sameBits(batch.hit(k), expectedHits[next])) << "sample " << next;
+                } else {
+                  const float depth = batch.depth(k);
+                  ASSERT_EQ(0, std::memcmp(&expectedHits[next].depth, &depth, sizeof(float)))
+                      << "sample " << next;
+                }
+                if (k > 0) {
+                  ASSERT_LE(got.run[k - 1], got.run[k]);
+                }
+                if (!inputs) {
+                  ASSERT_TRUE(got.dirX == nullptr && got.b1 == nullptr && got.runCorners == nullptr);
+                  ASSERT_EQ(got.runInstance[got.run[k]], e.instance) << "sample " << next;
+                  ASSERT_EQ(got.runTriangle[got.run[k]], e.triangle) << "sample " << next;
+                  continue;
+                }
+                const ShadeHit a{got.runInstance[got.run[k]],
+                                 got.runTriangle[got.run[k]],
+                                 got.b1[k],
+                                 got.b2[k],
+                                 {got.dirX[k], got.dirY[k], got.dirZ[k]},
+                                 {got.footprintX[k], got.footprintY[k]},
+                                 1.0f};
+                ASSERT_TRUE(sameBits(a, e)) << "sample " << next;
               }
-              const ShadeHit a{got.runInstance[got.run[k]],
-                               got.runTriangle[got.run[k]],
-                               got.b1[k],
-                               got.b2[k],
-                               {got.dirX[k], got.dirY[k], got.dirZ[k]},
-                               {got.footprintX[k], got.footprintY[k]},
-                               1.0f};
-              ASSERT_TRUE(sameBits(a, e)) << "sample " << next;
-              if (k > 0) {
-                ASSERT_LE(got.run[k - 1], got.run[k]);
+              batch.clear();
+            };
+            for (size_t r = 0; r < rows.size(); ++r) {
+              const Row& row = rows[r];
+              for (size_t i = 0; i < row.winners.size();) {
+                i = batch.addRow(row.winners.data(), i, row.winners.size(), spp, row.x0, row.y, grid->data(),
+                                 uint32_t(r * 1000), localOut);
+                if (batch.full()) check();
               }
+              // Every few rows a partial block, as a tile's last one.
+              if (r % 5 == 4 && batch.size() > 0) check();
             }
-            batch.clear();
-          };
-          for (size_t r = 0; r < rows.size(); ++r) {
-            const Row& row = rows[r];
-            for (size_t i = 0; i < row.winners.size();) {
-              i = batch.addRow(row.winners.data(), i, row.winners.size(), spp, row.x0, row.y, grid->data(),
-                               uint32_t(r * 1000), localOut);
-              if (batch.full()) check();
-            }
-            // Every few rows a partial block, as a tile's last one.
-            if (r % 5 == 4 && batch.size() > 0) check();
+            if (batch.size() > 0) check();
+            EXPECT_EQ(next, n);
           }
-          if (batch.size() > 0) check();
-          EXPECT_EQ(next, n);
-        }
       hwy::SetSupportedTargetsForTest(0);
     }
   }
