@@ -212,14 +212,17 @@ TEST(ParallelBinning, SameBinsAtAnyThreadCountAndNoCoveredTileLeftOut) {
   }
 }
 
-TEST(ParallelBinning, SelectKeepsOnlyTheChosenSetups) {
+// The chosen setups only, each in the tiles forEachBinnedTile gives it
+// (the filling pass takes a several-tile setup's tiles from the counting
+// pass's list, not from the setup).
+TEST(ParallelBinning, SelectKeepsOnlyTheChosenSetupsInTheirTiles) {
   const Scene scene = randomScene(5);
   const Frame f = frameOf(128, 128, 1);
   SetupCounters n;
   const auto setups = prepareTriangles(scene, f.space, f.grid, f.depth, CullMode::None, {}, &n);
   const TileGrid tiles(128, 128);
-  const auto odd =
-      binTriangles(tiles, f.grid, setups, [](const TriangleSetup& t) { return t.triangle % 2 == 1; });
+  const auto isOdd = [](const TriangleSetup& t) { return t.triangle % 2 == 1; };
+  const auto odd = binTriangles(tiles, f.grid, setups, isOdd);
   size_t count = 0;
   for (const auto& bin : odd)
     for (uint32_t i : bin) {
@@ -227,6 +230,19 @@ TEST(ParallelBinning, SelectKeepsOnlyTheChosenSetups) {
       ++count;
     }
   EXPECT_GT(count, 0u);
+  std::vector<std::vector<uint32_t>> reference(size_t(tiles.count()));
+  size_t severalTiles = 0;
+  for (size_t i = 0; i < setups.size(); ++i) {
+    if (!isOdd(setups[i])) continue;
+    int tilesOf = 0;
+    forEachBinnedTile(tiles, f.grid.unitsPerPixel, SampleBox(f.grid), setups[i], [&](int tile) {
+      reference[size_t(tile)].push_back(uint32_t(i));
+      ++tilesOf;
+    });
+    severalTiles += tilesOf > 1 ? 1 : 0;
+  }
+  EXPECT_GT(severalTiles, 5u);
+  EXPECT_EQ(odd, reference);
 }
 
 // A cube face's candidate bit may be clear only for triangles that set up
