@@ -171,6 +171,30 @@ RefinePlane refinePlaneReference(const Scene& scene, uint32_t instance, uint32_t
   return p;
 }
 
+namespace {
+
+using CornerLanes = double[3][3][setup_planes_detail::kBlock];  // [corner][axis][lane]
+
+// Lane k of a block's corners: the stored corners' positions, widened to double.
+void gatherCorners(const Scene& scene, const glm::uvec3& corners, size_t k, CornerLanes& c) {
+  for (int i = 0; i < 3; ++i) {
+    const glm::vec3& p = scene.positions[corners[i]];
+    c[i][0][k] = double(p.x), c[i][1][k] = double(p.y), c[i][2][k] = double(p.z);
+  }
+}
+
+// Pads the n gathered lanes to whole vectors with the last triangle again
+// (never read back); returns the lanes the kernel runs.
+size_t padCorners(size_t n, size_t vectorLanes, CornerLanes& c) {
+  const size_t lanes = (n + vectorLanes - 1) / vectorLanes * vectorLanes;
+  for (size_t k = n; k < lanes; ++k)
+    for (int i = 0; i < 3; ++i)
+      for (int a = 0; a < 3; ++a) c[i][a][k] = c[i][a][n - 1];
+  return lanes;
+}
+
+}  // namespace
+
 void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count, const glm::dvec3& eye,
                   RefinePlane* out) {
   using setup_planes_detail::kBlock;
@@ -184,17 +208,9 @@ void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count,
     const size_t n = std::min(kBlock, count - first);
     for (size_t k = 0; k < n; ++k) {
       const TriangleSetup& t = setups[first + k];
-      const glm::uvec3 v = scene.triangle(t.instance, t.triangle);
-      for (int c = 0; c < 3; ++c) {
-        const glm::vec3& p = scene.positions[v[c]];
-        b.c[c][0][k] = double(p.x), b.c[c][1][k] = double(p.y), b.c[c][2][k] = double(p.z);
-      }
+      gatherCorners(scene, scene.triangle(t.instance, t.triangle), k, b.c);
     }
-    // Padding: the last triangle again, never read back.
-    b.lanes = (n + vectorLanes - 1) / vectorLanes * vectorLanes;
-    for (size_t k = n; k < b.lanes; ++k)
-      for (int c = 0; c < 3; ++c)
-        for (int a = 0; a < 3; ++a) b.c[c][a][k] = b.c[c][a][n - 1];
+    b.lanes = padCorners(n, vectorLanes, b.c);
     HWY_DYNAMIC_DISPATCH(LanesRefinePlanes)(&b, eyeLanes);
     for (size_t k = 0; k < n; ++k) {
       RefinePlane& p = out[first + k];
@@ -218,18 +234,8 @@ void faceNormals(const Scene& scene, TriangleSetup* setups, size_t count) {
   const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(PlaneLanes)();
   for (size_t first = 0; first < count; first += kBlock) {
     const size_t n = std::min(kBlock, count - first);
-    for (size_t k = 0; k < n; ++k) {
-      const glm::uvec3& v = setups[first + k].corners;
-      for (int c = 0; c < 3; ++c) {
-        const glm::vec3& p = scene.positions[v[c]];
-        b.c[c][0][k] = double(p.x), b.c[c][1][k] = double(p.y), b.c[c][2][k] = double(p.z);
-      }
-    }
-    // Padding: the last triangle again, never read back.
-    b.lanes = (n + vectorLanes - 1) / vectorLanes * vectorLanes;
-    for (size_t k = n; k < b.lanes; ++k)
-      for (int c = 0; c < 3; ++c)
-        for (int a = 0; a < 3; ++a) b.c[c][a][k] = b.c[c][a][n - 1];
+    for (size_t k = 0; k < n; ++k) gatherCorners(scene, setups[first + k].corners, k, b.c);
+    b.lanes = padCorners(n, vectorLanes, b.c);
     HWY_DYNAMIC_DISPATCH(LanesFaceNormals)(&b);
     for (size_t k = 0; k < n; ++k) setups[first + k].faceNormal = {b.n[0][k], b.n[1][k], b.n[2][k]};
   }
