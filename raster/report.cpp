@@ -80,6 +80,7 @@ void reportCounters(const SetupCounters& setup, uint64_t trianglesSetup, const T
   k.set("raster.shadow_map_triangles", shadows.triangles);
   k.set("raster.shadow_map_transmissive_fragments", shadows.transmissiveFragments);
   k.set("raster.shaded_samples", tiles.shadedSamples);
+  k.set("raster.refined_samples", tiles.refinedSamples);
   k.set("raster.wireframe_pixels", wireframePixels);
 }
 

@@ -22,6 +22,7 @@ ThreadCounters& ThreadCounters::operator+=(const ThreadCounters& other) {
   blendSamplesTested += other.blendSamplesTested;
   fragmentsTransparent += other.fragmentsTransparent;
   shadedSamples += other.shadedSamples;
+  refinedSamples += other.refinedSamples;
   peelPasses += other.peelPasses;
   depthSeconds += other.depthSeconds;
   shadeSeconds += other.shadeSeconds;
@@ -195,6 +196,7 @@ glm::vec4 TileRenderer::shadeAt(const SampleHit& hit, const glm::dvec2& pos, con
   glm::vec4 c;
   shadePrimaryHits(shader_, &request, 1, &c, shadingPath());
   ++n.shadedSamples;
+  ++n.refinedSamples;
   return c;
 }
 

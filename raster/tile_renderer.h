@@ -52,6 +52,9 @@ struct ThreadCounters {
   uint64_t blendSamplesTested = 0;  // covered BLEND samples tested against the opaque depth
   uint64_t fragmentsTransparent = 0;
   uint64_t shadedSamples = 0;
+  // Of those, the samples given a primary ray and a refined hit (none in
+  // an unlit, emissive scene: PrimaryHitShader::needsHitInputs).
+  uint64_t refinedSamples = 0;
   uint64_t peelPasses = 0;
   // Thread-seconds per pass of the tiles (three clock reads per tile):
   // rasterizer.cpp splits the tile loop's wall time among them.

@@ -178,6 +178,23 @@ TEST(ShadingRate, PixelRateShadesOncePerPixelAndTriangle) {
   EXPECT_EQ(perPixel.image.color, perSample.image.color);
 }
 
+// SPEC §8's leaving out, counted: an unlit, emissive surface (black base
+// colour under the eye light) has one colour, so its samples get no
+// primary ray and no refined hit; a lit base colour gets both per sample.
+TEST(LeftOut, AnEmissiveSurfaceIsShadedWithoutRefinedHits) {
+  for (const bool black : {true, false}) {
+    Scene scene;
+    Material m = colored(black ? glm::vec4(0, 0, 0, 1) : glm::vec4(0.5f, 0.5f, 0.5f, 1));
+    m.emissive = glm::vec3(1.0f, 0.5f, 0.25f);
+    addMesh(scene, {{-1, -1, -2}, {1, -1, -2}, {0, 1, -2}}, {{0, 1, 2}}, m);
+    const Camera camera = test::perspectiveCamera(16, 16, 1.0, glm::dvec3(0.0), glm::dvec3(0, 0, -1));
+    const RenderOutput out = test::render(scene, camera, RasterOptions{});
+    const uint64_t shaded = out.counters.get("raster.shaded_samples");
+    EXPECT_GT(shaded, 0u);
+    EXPECT_EQ(out.counters.get("raster.refined_samples"), black ? 0u : shaded) << "black " << black;
+  }
+}
+
 TEST(SampleCounts, GridPatternsShareTheCentreSample) {
   const Scene scene = loadScene(test::scenePath("three-triangles.gltf"));
   const Camera camera = makeCamera(scene, CameraOverrides{}, 8, 8);
