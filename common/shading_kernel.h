@@ -176,8 +176,8 @@ class PrimaryHitShader {
   // scalar path; no diffuse term, or the eye light on a black base colour:
   // an emissive, unlit surface): a block's colours are then its runs'
   // instances' colours, the same bits as the lanes give (tested), and
-  // PrimaryHitBlock's per-hit inputs may be null. Not cached: ask once
-  // per tile.
+  // PrimaryHitBlock's per-hit inputs may be null. Not cached: it looks
+  // at every instance, so ask once per frame.
   bool needsHitInputs() const;
 
  private:

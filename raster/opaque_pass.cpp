@@ -63,8 +63,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
   batch.wantInterpolated(!lean);  // the lean form reads no front hits
   PrimaryHitShader kernel(shader_, shadingPath());
   // An unlit, emissive scene's colours need no ray and no refined hit.
-  const bool refines = kernel.needsHitInputs();
-  batch.wantShadingInputs(refines);
+  batch.wantShadingInputs(refinesHits_);
   alignas(64) uint32_t localOut[kPrimaryHitBlock];  // the sample each is shaded at
   alignas(64) double footprintX[kPrimaryHitBlock],
       footprintY[kPrimaryHitBlock];  // image position of the footprint
@@ -90,7 +89,7 @@ void TileRenderer::shadeVisible(const TileSampleIndex& index, const DepthTarget&
     }
     kernel.shade(batch.hits(fpX, fpY, localOut), samples.color.data());
     n.shadedSamples += count;
-    if (refines) n.refinedSamples += count;
+    if (refinesHits_) n.refinedSamples += count;
     batch.clear();
   };
   const auto addRequest = [&](uint32_t win, uint32_t local, const glm::dvec2& pos,

@@ -44,7 +44,8 @@ TileRenderer::TileRenderer(const Scene& scene, const SceneAnalysis& analysis, co
       planes_(planes),
       rays_(camera),
       primaryConstants_(camera),
-      centre_(centreSampleIndex(options.spp)) {}
+      centre_(centreSampleIndex(options.spp)),
+      refinesHits_(PrimaryHitShader(shader, shadingPath()).needsHitInputs()) {}
 
 namespace {
 

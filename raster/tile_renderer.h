@@ -184,6 +184,9 @@ class TileRenderer {
   PrimaryRays rays_;                      // camera_'s primary rays (bit-identical to Camera::primaryRay)
   PrimaryRayConstants primaryConstants_;  // the same rays for primarySamples' lanes
   int centre_;
+  // PrimaryHitShader::needsHitInputs for the frame, asked once here: it
+  // looks at every instance, too much to ask per tile.
+  bool refinesHits_;
 };
 
 // The frame's deep image from every tile's deep samples and per-pixel counts
