@@ -100,19 +100,6 @@ ShadowMaps::Lookup lookupOf(const Camera& camera, const ClipSpace& space) {
   return k;
 }
 
-// Indexes a tile's sorted fragments by row: rows[r] is the first
-// fragment of the tile's row r (kTileSize + 1 entries, the last the
-// size), `y0` the tile's first row, `width` the map's.
-void indexTileRows(const std::vector<ShadowMaps::Attenuation>& fragments, size_t y0, size_t width,
-                   uint32_t* rows) {
-  size_t next = 0;  // the next row of the tile whose start is not yet set
-  for (size_t at = 0; at < fragments.size(); ++at) {
-    const size_t row = fragments[at].texel / width - y0;
-    for (; next <= row; ++next) rows[next] = uint32_t(at);
-  }
-  for (; next <= size_t(kTileSize); ++next) rows[next] = uint32_t(fragments.size());
-}
-
 // The receiver's normal in the map's view frame (the rotation of
 // viewFromWorld), one order of operations for both lookups.
 glm::dvec3 viewNormal(const ShadowMaps::Lookup& k, const glm::dvec3& normal) {
@@ -146,6 +133,95 @@ double receiverDepth(const ShadowMaps::Lookup& k, const glm::dvec3& view, double
     dc = (n.x * view.x + n.y * view.y + n.z * view.z) / (n.x * a + n.y * b - n.z);  // the ray t·(a, b, −1)
   if (!(dc > k.znear) || !std::isfinite(dc)) return d;
   return std::min(d, dc);
+}
+
+// Renders one map (a cube face, a spot or a directional light's map) of
+// `size` texels a side seen by `c` into `*out`, from the triangles
+// `filter` keeps; `*trianglesIn` the setup's input count. Maps are
+// independent: the constructor renders all of a frame's at once.
+void renderMap(const Scene& scene, const RasterOptions& options, const Shader* shader, CoveragePath path,
+               const Camera& c, int size, const TriangleFilter& filter, ShadowMaps::Map* out,
+               uint64_t* trianglesIn) {
+  using Map = ShadowMaps::Map;
+  using Attenuation = ShadowMaps::Attenuation;
+  const SampleGrid grid = makeSampleGrid(1, size, size);
+  Map& map = *out;
+  map = Map{c,
+            makeClipSpace(c, grid.guardPixels),
+            {},
+            BlockDepthMap(size, size, kMapFormat, grid.positions[0]),
+            TileGrid(size, size),
+            {},
+            {}};
+  map.lookup = lookupOf(map.camera, map.space);
+  DepthSettings ds{
+      kMapFormat, c.projection, c.znear, c.zfar, options.shadowBiasSlope, options.shadowBiasConstant};
+  SetupCounters counters;
+  const std::vector<TriangleSetup> setups =
+      prepareTriangles(scene, map.space, grid, ds, options.cull, filter, &counters);
+  *trianglesIn = counters.trianglesIn;
+  const TileGrid& tiles = map.tiles;
+  // BLEND and refractive surfaces attenuate instead of blocking (with a
+  // shader to ask how much); everything else writes depth.
+  const auto transmissive = [&](const TriangleSetup& t) {
+    const Material& m = scene.materialOf(t.instance);
+    return shader && (m.alphaMode == AlphaMode::Blend || m.isRefractive());
+  };
+  const auto bins =
+      binTriangles(tiles, grid, setups, [&](const TriangleSetup& t) { return !transmissive(t); });
+  const auto transmissiveBins = binTriangles(tiles, grid, setups, transmissive);
+  const auto surfaceAt = [&](const TriangleSetup& t, int px, int py, int s) {
+    const glm::dvec2 pos = glm::dvec2(px, py) + grid.positions[size_t(s)];
+    const glm::dvec2 b = t.baryAt(pos.x, pos.y);
+    SampleHit hit{t.instance, t.triangle, float(t.viewDepthAt(pos.x, pos.y)), float(b.x), float(b.y)};
+    return makeSurfacePoint(scene, refineHit(scene, c.primaryRay(pos), hit));
+  };
+  // The alpha test only where a MASK material can use it: without one,
+  // the depth pass runs its lean path (no call per sample).
+  const bool anyMask = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                   [](const Material& m) { return m.alphaMode == AlphaMode::Mask; });
+  AlphaTestFunction alphaTest;
+  if (shader && anyMask)
+    alphaTest = [&](const TriangleSetup& t, int px, int py, int s) {
+      const Material& m = scene.materialOf(t.instance);
+      if (m.alphaMode != AlphaMode::Mask) return true;
+      return shader->coverageAlpha(surfaceAt(t, px, py, s), TextureFootprint{}) >= m.alphaCutoff;
+    };
+  map.attenuation.resize(size_t(tiles.count()));
+  map.attenuationTexels.resize(size_t(tiles.count()));
+  parallelFor(0, tiles.count(), [&](int tile) {
+    if (stopRequested(options.cancel)) return;  // Ctrl-C or cancelled: the constructor throws
+    DepthPassCounters dc;
+    const TileRect rect = tiles.rect(tile);
+    DepthOnlyTile depth(rect);
+    depth.render(setups, bins[size_t(tile)], grid, kMapFormat, alphaTest, &dc, path);
+    if (!transmissiveBins[size_t(tile)].empty()) depth.loadAll();  // key() below reads the buffer
+    // Attenuating fragments in front of the opaque depth, kept per texel.
+    std::vector<Attenuation>& found = map.attenuation[size_t(tile)];
+    CoverageScratch scratch;
+    for (uint32_t index : transmissiveBins[size_t(tile)]) {
+      const TriangleSetup& t = setups[index];
+      // Untextured, without vertex colours: the transmittance is the
+      // material's, the same everywhere.
+      const Material& m = scene.materialOf(t.instance);
+      const bool constant = m.baseColorTexture < 0 && !scene.instanceOf(t.instance).hasColors;
+      SurfacePoint any;
+      any.material = &m;
+      const glm::vec3 uniform = constant ? shader->shadowTransmittance(any) : glm::vec3(1.0f);
+      forEachCoveredSample(t, grid, rect, scratch, [&](int px, int py, int s) {
+        const size_t texel = map.depth.index(px, py);
+        const uint32_t key = sampleDepthKey(t, grid, kMapFormat, px, py, s);
+        if (key >= depth.key(px, py)) return;
+        const glm::vec3 pass = constant ? uniform : shader->shadowTransmittance(surfaceAt(t, px, py, s));
+        found.emplace_back(uint32_t(texel), key, pass);
+      });
+    }
+    depth.store(&map.depth);
+    // By (texel, key); stable: equal keys keep the order met.
+    sortTileFragments(rect, size_t(map.depth.width), &found, &map.attenuationTexels[size_t(tile)]);
+  });
+  if (stopRequested(options.cancel)) return;  // the constructor throws
+  map.depth.keepPlanes(setups);
 }
 
 }  // namespace
@@ -241,6 +317,15 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
     centre = 0.5 * (scene.bounds.lo + scene.bounds.hi);
     radius = std::max(1e-6, 0.5 * glm::length(scene.bounds.hi - scene.bounds.lo));
   }
+  // Every light's maps, lights in order: their cameras and, for a cube
+  // map, which faces each triangle can reach.
+  struct MapOfLight {
+    size_t light, index;
+    Camera camera;
+    TriangleFilter filter;
+  };
+  std::vector<MapOfLight> all;
+  std::vector<std::vector<uint8_t>> faces(scene.lights.size());
   perLight_.resize(scene.lights.size());
   for (size_t l = 0; l < scene.lights.size(); ++l) {
     const Light& light = scene.lights[l];
@@ -258,96 +343,31 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         cameras = cubeFaceCameras(light.position, size, znear);
     }
     const bool cube = cameras.size() == kCubeFaces;
-    std::vector<uint8_t> faces;
-    for (size_t f = 0; f < cameras.size(); ++f) {
-      const Camera& c = cameras[f];
-      const SampleGrid grid = makeSampleGrid(1, size, size);
-      Map map{c,
-              makeClipSpace(c, grid.guardPixels),
-              {},
-              BlockDepthMap(size, size, kMapFormat, grid.positions[0]),
-              TileGrid(size, size),
-              {},
-              {}};
-      map.lookup = lookupOf(map.camera, map.space);
-      if (cube && faces.empty()) faces = cubeFaceCandidates(scene, light.position, map.space.scale.x, size);
-      DepthSettings ds{
-          kMapFormat, c.projection, c.znear, c.zfar, options.shadowBiasSlope, options.shadowBiasConstant};
-      SetupCounters counters;
-      const TriangleFilter filter{true, true, cube ? &faces : nullptr, uint8_t(cube ? 1u << f : 0u)};
-      const std::vector<TriangleSetup> setups =
-          prepareTriangles(scene, map.space, grid, ds, options.cull, filter, &counters);
-      triangles_ += counters.trianglesIn;
-      const TileGrid& tiles = map.tiles;
-      // BLEND and refractive surfaces attenuate instead of blocking (with a
-      // shader to ask how much); everything else writes depth.
-      const auto transmissive = [&](const TriangleSetup& t) {
-        const Material& m = scene.materialOf(t.instance);
-        return shader && (m.alphaMode == AlphaMode::Blend || m.isRefractive());
-      };
-      const auto bins =
-          binTriangles(tiles, grid, setups, [&](const TriangleSetup& t) { return !transmissive(t); });
-      const auto transmissiveBins = binTriangles(tiles, grid, setups, transmissive);
-      const auto surfaceAt = [&](const TriangleSetup& t, int px, int py, int s) {
-        const glm::dvec2 pos = glm::dvec2(px, py) + grid.positions[size_t(s)];
-        const glm::dvec2 b = t.baryAt(pos.x, pos.y);
-        SampleHit hit{t.instance, t.triangle, float(t.viewDepthAt(pos.x, pos.y)), float(b.x), float(b.y)};
-        return makeSurfacePoint(scene, refineHit(scene, c.primaryRay(pos), hit));
-      };
-      // The alpha test only where a MASK material can use it: without one,
-      // the depth pass runs its lean path (no call per sample).
-      const bool anyMask = std::any_of(scene.materials.begin(), scene.materials.end(),
-                                       [](const Material& m) { return m.alphaMode == AlphaMode::Mask; });
-      AlphaTestFunction alphaTest;
-      if (shader && anyMask)
-        alphaTest = [&](const TriangleSetup& t, int px, int py, int s) {
-          const Material& m = scene.materialOf(t.instance);
-          if (m.alphaMode != AlphaMode::Mask) return true;
-          return shader->coverageAlpha(surfaceAt(t, px, py, s), TextureFootprint{}) >= m.alphaCutoff;
-        };
-      map.attenuation.resize(size_t(tiles.count()));
-      map.attenuationRows.resize(size_t(tiles.count()) * size_t(kTileSize + 1));
-      parallelFor(0, tiles.count(), [&](int tile) {
-        if (stopRequested(options.cancel)) return;  // Ctrl-C or cancelled: thrown below
-        DepthPassCounters dc;
-        const TileRect rect = tiles.rect(tile);
-        DepthOnlyTile depth(rect);
-        depth.render(setups, bins[size_t(tile)], grid, kMapFormat, alphaTest, &dc, path);
-        if (!transmissiveBins[size_t(tile)].empty()) depth.loadAll();  // key() below reads the buffer
-        // Attenuating fragments in front of the opaque depth, kept per texel.
-        std::vector<Attenuation>& found = map.attenuation[size_t(tile)];
-        CoverageScratch scratch;
-        for (uint32_t index : transmissiveBins[size_t(tile)]) {
-          const TriangleSetup& t = setups[index];
-          // Untextured, without vertex colours: the transmittance is the
-          // material's, the same everywhere.
-          const Material& m = scene.materialOf(t.instance);
-          const bool constant = m.baseColorTexture < 0 && !scene.instanceOf(t.instance).hasColors;
-          SurfacePoint any;
-          any.material = &m;
-          const glm::vec3 uniform = constant ? shader->shadowTransmittance(any) : glm::vec3(1.0f);
-          forEachCoveredSample(t, grid, rect, scratch, [&](int px, int py, int s) {
-            const size_t texel = map.depth.index(px, py);
-            const uint32_t key = sampleDepthKey(t, grid, kMapFormat, px, py, s);
-            if (key >= depth.key(px, py)) return;
-            const glm::vec3 pass = constant ? uniform : shader->shadowTransmittance(surfaceAt(t, px, py, s));
-            found.push_back({uint32_t(texel), key, pass});
-          });
-        }
-        depth.store(&map.depth);
-        // By (texel, key); stable: equal keys keep the order met.
-        sortTileFragments(rect, size_t(map.depth.width), &found);
-        indexTileRows(found, size_t(rect.y0), size_t(map.depth.width),
-                      &map.attenuationRows[size_t(tile) * size_t(kTileSize + 1)]);
-      });
-      throwIfStopped(options.cancel);
-      map.depth.keepPlanes(setups);
-      for (const auto& v : map.attenuation) attenuating_ += v.size();
-      perLight_[l].push_back(std::move(map));
+    if (cube) {
+      const ClipSpace space = makeClipSpace(cameras[0], makeSampleGrid(1, size, size).guardPixels);
+      faces[l] = cubeFaceCandidates(scene, light.position, space.scale.x, size);
     }
+    perLight_[l].resize(cameras.size());
+    for (size_t f = 0; f < cameras.size(); ++f)
+      all.push_back({l, f, cameras[f],
+                     TriangleFilter{true, true, cube ? &faces[l] : nullptr, uint8_t(cube ? 1u << f : 0u)}});
   }
+  // The maps in parallel, each over its tiles in parallel: while one map
+  // sets up and bins its triangles or ends (serial steps), the other
+  // threads draw another's tiles.
+  std::vector<uint64_t> trianglesIn(all.size(), 0);
+  parallelFor(0, int(all.size()), [&](int i) {
+    const MapOfLight& m = all[size_t(i)];
+    renderMap(scene, options, shader, path, m.camera, size, m.filter, &perLight_[m.light][m.index],
+              &trianglesIn[size_t(i)]);
+  });
+  throwIfStopped(options.cancel);
+  for (uint64_t n : trianglesIn) triangles_ += n;
   for (const auto& maps : perLight_)
-    for (const Map& m : maps) maps_.push_back(&m);
+    for (const Map& m : maps) {
+      maps_.push_back(&m);
+      for (const auto& v : m.attenuation) attenuating_ += v.size();
+    }
 }
 
 // The reference lookup: project with the general functions, then binary
@@ -403,30 +423,27 @@ glm::vec3 ShadowMaps::lit(const Map& map, const glm::dvec3& world, const glm::dv
   else
     z = k.znear * (k.zfar - dc) / (dc * (k.zfar - k.znear));
   const uint32_t key = depthKey(kMapFormat, z);
-  const uint32_t texel = uint32_t(map.depth.index(x, y));
   if (key > map.depth.key(x, y)) return glm::vec3(0.0f);
   // Attenuation by the transmissive layers between the light and the point:
-  // only the fragments of the texel's row within its tile are searched.
+  // the texel's fragments start where its tile's texel index says, no search.
   const size_t tile = size_t(y / kTileSize) * size_t(map.tiles.tilesX) + size_t(x / kTileSize);
-  const size_t slot = tile * (kTileSize + 1) + size_t(y % kTileSize);
-  const uint32_t first = map.attenuationRows[slot], last = map.attenuationRows[slot + 1];
+  const std::vector<uint32_t>& starts = map.attenuationTexels[tile];
   glm::vec3 t = one;
-  if (first == last) return t;
+  if (starts.empty()) return t;
+  const size_t slot = size_t(y % kTileSize) * size_t(kTileSize) + size_t(x % kTileSize);
   const Attenuation* a = map.attenuation[tile].data();
-  const Attenuation* it = std::lower_bound(a + first, a + last, texel,
-                                           [](const Attenuation& f, uint32_t tx) { return f.texel < tx; });
-  for (; it != a + last && it->texel == texel && it->key < key; ++it) t *= it->transmittance;
+  const Attenuation* last = a + starts[slot + 1];
+  for (const Attenuation* it = a + starts[slot]; it != last && it->key < key; ++it) t *= it->transmittance;
   return t;
 }
 
-void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMaps::Attenuation>* found) {
+void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMaps::Attenuation>* found,
+                       std::vector<uint32_t>* texelStarts) {
   using A = ShadowMaps::Attenuation;
-  const auto before = [](const A& a, const A& b) {
-    return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
-  };
   std::vector<A>& v = *found;
-  if (v.size() < 256) {
-    std::stable_sort(v.begin(), v.end(), before);
+  std::vector<uint32_t>& start = *texelStarts;
+  if (v.empty()) {
+    start.clear();
     return;
   }
   // Texel (x, y) of the rect: slot (y − y0)·kTileSize + (x − x0), in the
@@ -435,7 +452,6 @@ void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMap
   // own, kept between tiles.
   const uint32_t w = uint32_t(width), x0 = uint32_t(rect.x0), y0 = uint32_t(rect.y0);
   thread_local std::vector<uint16_t> slots;
-  thread_local std::vector<uint32_t> start;
   thread_local std::vector<A> sorted;
   slots.resize(v.size());
   start.assign(size_t(kTileSize) * kTileSize + 1, 0);

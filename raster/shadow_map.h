@@ -31,8 +31,8 @@
 // costs a few double operations (the reference's, inlined: same bits),
 // one load from the blocks' table (256 KB a 2048² face) and either the
 // block's plane evaluated at the texel or one load of its keys; the
-// transmissive fragments are indexed by tile row, so a texel without any
-// costs one more load and no search.
+// transmissive fragments are indexed by texel within their tile: two
+// loads find a texel's (none, or its layers in order), no search.
 #pragma once
 
 #include <cstdint>
@@ -109,6 +109,13 @@ class ShadowMaps : public LightVisibility {
     uint32_t texel;
     uint32_t key;  // depth key from the light, bias applied
     glm::vec3 transmittance;
+    Attenuation() = default;
+    // For emplace_back: the fields stored in place. A braced temporary
+    // pushed back was assembled on the stack by narrow stores and copied
+    // with a 16-byte load, which stalled on store forwarding (a third of
+    // the tile's fragment loop at 2048²).
+    Attenuation(uint32_t atTexel, uint32_t keyFromLight, const glm::vec3& passed)
+        : texel(atTexel), key(keyFromLight), transmittance(passed) {}
   };
   // What a lookup needs of a map, precomputed: the view matrix's x, y and
   // z rows (glm's column order of operations kept, so the view position
@@ -133,9 +140,13 @@ class ShadowMaps : public LightVisibility {
     // by (texel, key); equal keys at a texel in the order the pass met
     // them (bin order, then texel order).
     std::vector<std::vector<Attenuation>> attenuation;
-    // Per tile, kTileSize + 1 entries (tile · (kTileSize + 1) + row): the
-    // first fragment of each row of the tile in its vector, then its size.
-    std::vector<uint32_t> attenuationRows;
+    // Per tile, the first fragment of each of its texels in its vector:
+    // kTileSize² + 1 entries, texel (x, y) of the tile at (y mod
+    // kTileSize) · kTileSize + x mod kTileSize, the last the size; empty
+    // for a tile without fragments. A lookup finds its texel's fragments
+    // without a search (the binary search of the texel's row, a third of
+    // the lookup's samples under the Cornell box's glass sphere).
+    std::vector<std::vector<uint32_t>> attenuationTexels;
   };
 
   // Map i, lights in order (a point light's six faces in face order).
@@ -155,10 +166,11 @@ class ShadowMaps : public LightVisibility {
 
 // Sorts one map tile's transmissive fragments (texels of `rect`, in a map
 // `width` texels wide) by (texel, key), equal pairs in the order given:
-// std::stable_sort's result. Many fragments (a glass sphere over the tile:
-// thousands, a few per texel) are counted into texel order in one linear
-// pass and each texel's few then sorted by key; fewer go to
-// std::stable_sort.
-void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMaps::Attenuation>* fragments);
+// std::stable_sort's result, counted into texel order in one linear pass
+// (a glass sphere over the tile: thousands, a few per texel) and each
+// texel's few then sorted by key. `texelStarts` gets the tile's texel
+// index (Map::attenuationTexels): empty without fragments.
+void sortTileFragments(const TileRect& rect, size_t width, std::vector<ShadowMaps::Attenuation>* fragments,
+                       std::vector<uint32_t>* texelStarts);
 
 }  // namespace rastray

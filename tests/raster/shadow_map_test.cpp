@@ -95,7 +95,7 @@ TEST(ShadowMapPass, FastMapsEqualTheReferenceWalks) {
           EXPECT_EQ(a.attenuation[tile][k].transmittance, b.attenuation[tile][k].transmittance);
         }
       }
-      EXPECT_EQ(a.attenuationRows, b.attenuationRows) << "map " << i;
+      EXPECT_EQ(a.attenuationTexels, b.attenuationTexels) << "map " << i;
     }
   }
 }
@@ -198,7 +198,8 @@ TEST(ShadowMapPass, TileFragmentSortIsTheStableSortByTexelAndKey) {
                        [](const ShadowMaps::Attenuation& a, const ShadowMaps::Attenuation& b) {
                          return a.texel != b.texel ? a.texel < b.texel : a.key < b.key;
                        });
-      sortTileFragments(rect, width, &v);
+      std::vector<uint32_t> starts;
+      sortTileFragments(rect, width, &v, &starts);
       ASSERT_EQ(v.size(), expected.size());
       for (size_t i = 0; i < n; ++i) {
         ASSERT_EQ(v[i].texel, expected[i].texel) << "tile " << tile << " n " << n << " at " << i;
@@ -206,6 +207,47 @@ TEST(ShadowMapPass, TileFragmentSortIsTheStableSortByTexelAndKey) {
         ASSERT_EQ(v[i].transmittance, expected[i].transmittance)
             << "tile " << tile << " n " << n << " at " << i;
       }
+    }
+}
+
+// The tiles' texel index from the sort against each texel's first
+// fragment found by a scan: no fragments (no index), one, a few, many,
+// rows left empty at the top, middle and bottom, and a tile of 22 × 36
+// texels at the map's corner (the slots past its edges index the next
+// texel of the rect, the last the end).
+TEST(ShadowMapPass, TileTexelIndexIsEachTexelsFirstFragment) {
+  std::mt19937 rng(23);
+  const size_t width = 150, height = 100;  // tiles of 64, 64 and 22 columns, 64 and 36 rows
+  const TileGrid tiles{int(width), int(height)};
+  for (int tile : {0, 2, tiles.count() - 1})
+    for (size_t n : {size_t(0), size_t(1), size_t(7), size_t(500), size_t(5000)}) {
+      const TileRect rect = tiles.rect(tile);
+      const int w = rect.x1 - rect.x0, h = rect.y1 - rect.y0;
+      std::vector<ShadowMaps::Attenuation> v;
+      for (size_t i = 0; i < n; ++i) {
+        // Every third row left empty.
+        int y = rect.y0 + int(rng() % uint32_t(h));
+        if ((y - rect.y0) % 3 == 1) y = rect.y0;
+        const int x = rect.x0 + int(rng() % uint32_t(w));
+        v.push_back({uint32_t(size_t(y) * width + size_t(x)), uint32_t(rng() % 5), glm::vec3(1.0f)});
+      }
+      std::vector<uint32_t> starts{1, 2, 3};  // replaced
+      sortTileFragments(rect, width, &v, &starts);
+      if (n == 0) {
+        EXPECT_TRUE(starts.empty()) << "tile " << tile;
+        continue;
+      }
+      // A fragment's slot in the tile; the fragments are sorted by texel.
+      const auto slotOf = [&](const ShadowMaps::Attenuation& a) {
+        return (a.texel / width - size_t(rect.y0)) * size_t(kTileSize) + (a.texel % width - size_t(rect.x0));
+      };
+      std::vector<uint32_t> expected(size_t(kTileSize) * kTileSize + 1);
+      size_t first = 0;
+      for (size_t slot = 0; slot < expected.size(); ++slot) {
+        while (first < v.size() && slotOf(v[first]) < slot) ++first;
+        expected[slot] = uint32_t(first);
+      }
+      EXPECT_EQ(starts, expected) << "tile " << tile << " n " << n;
     }
 }
 
