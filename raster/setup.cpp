@@ -15,6 +15,7 @@
 #include "common/triangle_plane.h"
 #include "raster/depth.h"
 #include "raster/huge_pages.h"
+#include "raster/setup_classify.h"
 
 namespace rastray {
 
@@ -369,6 +370,18 @@ bool mayCoverSample(const TriangleSetup& t, const SampleGrid& grid) {
   return false;
 }
 
+void vertexCodesReference(const ClipSpace& space, double unitsPerPixel, const glm::vec3* positions,
+                          size_t count, uint8_t* outside, SnappedVertex* snapped) {
+  for (size_t v = 0; v < count; ++v) {
+    const glm::dvec4 clip = space.clipOf(glm::dvec3(positions[v]));
+    const uint8_t mask = outsidePlanes(space, clip);
+    outside[v] = mask;
+    if (mask != 0) continue;  // w may be <= 0: no image position
+    const glm::dvec2 image = space.imageOf(clip);
+    snapped[v] = {int32_t(snapUnits(image.x, unitsPerPixel)), int32_t(snapUnits(image.y, unitsPerPixel))};
+  }
+}
+
 namespace {
 
 // A run of one instance's triangles, set up together.
@@ -461,13 +474,10 @@ void setupClipped(const SetupContext& c, CullMode instanceCull, uint32_t instanc
 // without initialising: only the selected instances' vertices are written
 // and read.
 struct VertexCodes {
-  struct Snapped {
-    int32_t x, y;  // |X|, |Y| <= 2^29 (snapUnits clamps)
-  };
   std::unique_ptr<uint8_t[]> outside;
-  std::unique_ptr<Snapped[]> snapped;
+  std::unique_ptr<SnappedVertex[]> snapped;
 };
-static_assert(sizeof(uint8_t) + sizeof(VertexCodes::Snapped) == kSetupVertexCodeBytes);
+static_assert(sizeof(uint8_t) + sizeof(SnappedVertex) == kSetupVertexCodeBytes);
 
 // Loads a triangle's world positions; false when its world area is zero
 // (isDegenerate in common/scene.h on the positions already loaded).
@@ -590,13 +600,13 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
 }
 
 // Fills `codes` for every vertex of the instances the chunks cover, in
-// parallel.
+// parallel, in lanes (vertexCodes: vertexCodesReference's bits).
 void computeVertexCodes(const Scene& scene, const ClipSpace& space, const SampleGrid& grid,
                         const std::vector<uint32_t>& instances, VertexCodes* codes) {
   codes->outside.reset(new uint8_t[scene.positions.size()]);
-  codes->snapped.reset(new VertexCodes::Snapped[scene.positions.size()]);
+  codes->snapped.reset(new SnappedVertex[scene.positions.size()]);
   adviseHugePages(codes->outside.get(), scene.positions.size());
-  adviseHugePages(codes->snapped.get(), scene.positions.size() * sizeof(VertexCodes::Snapped));
+  adviseHugePages(codes->snapped.get(), scene.positions.size() * sizeof(SnappedVertex));
   struct Range {
     size_t begin, end;
   };
@@ -608,17 +618,9 @@ void computeVertexCodes(const Scene& scene, const ClipSpace& space, const Sample
     for (size_t v = inst.firstVertex; v < end; v += kBlock) ranges.push_back({v, std::min(end, v + kBlock)});
   }
   const double U = double(grid.unitsPerPixel);
-  uint8_t* outside = codes->outside.get();
-  VertexCodes::Snapped* snapped = codes->snapped.get();
   parallelFor(size_t(0), ranges.size(), [&](size_t r) {
-    for (size_t v = ranges[r].begin; v < ranges[r].end; ++v) {
-      const glm::dvec4 clip = space.clipOf(glm::dvec3(scene.positions[v]));
-      const uint8_t mask = outsidePlanes(space, clip);
-      outside[v] = mask;
-      if (mask != 0) continue;  // w may be <= 0: no image position
-      const glm::dvec2 image = space.imageOf(clip);
-      snapped[v] = {int32_t(snapUnits(image.x, U)), int32_t(snapUnits(image.y, U))};
-    }
+    const size_t v = ranges[r].begin;
+    vertexCodes(space, U, &scene.positions[v], ranges[r].end - v, &codes->outside[v], &codes->snapped[v]);
   });
 }
 
