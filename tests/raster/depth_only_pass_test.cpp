@@ -71,16 +71,23 @@ TEST(DepthKeys, RowKeysMatchTheScalarKeyBitForBit) {
   }
 }
 
+// A depth plane of a few thousand pixels' range with v0 in [lowest, highest).
+Plane randomPlane(std::mt19937& rng, double lowest, double highest) {
+  const auto u = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  Plane p;
+  p.v0 = u(lowest, highest);
+  p.dx = u(-1e-2, 1e-2);
+  p.dy = u(-1e-2, 1e-2);
+  p.x0 = u(-100, 3000);
+  p.y0 = u(-100, 3000);
+  return p;
+}
+
 TEST(DepthKeys, RowTermsAreThePlaneAtTheSample) {
   std::mt19937 rng(3);
   const auto u = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
   for (int round = 0; round < 2000; ++round) {
-    Plane p;
-    p.v0 = u(-2, 2);
-    p.dx = u(-1e-2, 1e-2);
-    p.dy = u(-1e-2, 1e-2);
-    p.x0 = u(-100, 3000);
-    p.y0 = u(-100, 3000);
+    const Plane p = randomPlane(rng, -2, 2);
     const int px0 = int(rng() % 2048), py = int(rng() % 2048);
     const double ox = u(0, 1), oy = u(0, 1);
     double column[8];
@@ -102,12 +109,7 @@ TEST(DepthKeys, PixelSampleKeysAreTheScalarKeyAtEachSample) {
   std::mt19937 rng(5);
   const auto u = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
   for (int round = 0; round < 4000; ++round) {
-    Plane p;
-    p.v0 = u(-0.5, 1.5);
-    p.dx = u(-1e-2, 1e-2);
-    p.dy = u(-1e-2, 1e-2);
-    p.x0 = u(-100, 3000);
-    p.y0 = u(-100, 3000);
+    const Plane p = randomPlane(rng, -0.5, 1.5);
     const int px = int(rng() % 2048), py = int(rng() % 2048);
     double qx[4], qy[4];
     for (int k = 0; k < 4; ++k) {
