@@ -317,8 +317,8 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
   // and height and hold at most this many samples takes the
   // small-triangle path below (masks of 64 bits: 64 samples at most).
   constexpr int kSmallSamples = 64;
-  alignas(16) int64_t smallOffsets[3][kSmallSamples];
   uint64_t smallMasks[kSmallSamples];
+  const glm::i64vec2* sampleOffsets = grid.offsets.data();
   // The next triangles' setups (304 bytes each, mostly not in cache at
   // 10^6 triangles) are fetched this many triangles ahead.
   constexpr size_t kPrefetch = 4;
@@ -524,10 +524,11 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
       // holds no covered sample is skipped: it tests and writes nothing,
       // and whether it is culled counts nothing either, so the keys,
       // winners and counters are the block walk's.
-      for (int e = 0; e < 3; ++e)
-        for (int k = 0; k < spp; ++k)
-          smallOffsets[e][k] =
-              t.edge[e].a * grid.offsets[size_t(k)].x + t.edge[e].b * grid.offsets[size_t(k)].y;
+      // Edge e's part of sample k's offset in the pixel (exact int64),
+      // added to the bounds' corner value where a sample's masks begin.
+      const auto sampleTerm = [&](int e, int k) {
+        return t.edge[e].a * sampleOffsets[k].x + t.edge[e].b * sampleOffsets[k].y;
+      };
       const int64_t X0 = int64_t(r.x0) * U, Y0 = int64_t(r.y0) * U;
       int64_t row0 = t.edge[0].at(X0, Y0) + t.edge[0].bias, row1 = t.edge[1].at(X0, Y0) + t.edge[1].bias,
               row2 = t.edge[2].at(X0, Y0) + t.edge[2].bias;
@@ -549,8 +550,8 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         for (int v = 1; v < 4; ++v) col[e][v] = _mm_add_epi64(col[e][v - 1], two);
       }
       for (int k = 0; k < spp; ++k) {
-        const int64_t r0 = row0 + smallOffsets[0][k], r1 = row1 + smallOffsets[1][k],
-                      r2 = row2 + smallOffsets[2][k];
+        const int64_t r0 = row0 + sampleTerm(0, k), r1 = row1 + sampleTerm(1, k),
+                      r2 = row2 + sampleTerm(2, k);
         const uint64_t m = (w <= 4 ? smallRows<2>(col, r0, r1, r2, stepY0, stepY1, stepY2, h)
                                    : smallRows<4>(col, r0, r1, r2, stepY0, stepY1, stepY2, h)) &
                            columns;
@@ -564,8 +565,7 @@ void rasterDepthPass(const std::vector<TriangleSetup>& setups, const std::vector
         for (int i = 0; i < w; ++i) {
           for (int k = 0; k < spp; ++k) {
             // Every one >= 0: their sign bits all clear.
-            const int64_t m =
-                (e0 + smallOffsets[0][k]) | (e1 + smallOffsets[1][k]) | (e2 + smallOffsets[2][k]);
+            const int64_t m = (e0 + sampleTerm(0, k)) | (e1 + sampleTerm(1, k)) | (e2 + sampleTerm(2, k));
             smallMasks[k] |= uint64_t(~m) >> 63 << (8 * j + i);
           }
           e0 += stepX0, e1 += stepX1, e2 += stepX2;

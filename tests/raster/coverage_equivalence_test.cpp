@@ -401,9 +401,9 @@ TEST(CoverageEquivalence, SmallTrianglePathWritesTheReferenceKeysAndWinners) {
 // 4 to 8 pixels, most across a block edge or corner) with a coplanar copy
 // of part of one (exact key ties, decided by id), then random triangles
 // behind them (blocks culled once written) and tiny ones in front, at 1,
-// 2, 4, 8 and 16 spp (from 4 on, samples tested from masks take a
-// pixel's four samples as one vector, ties included), both float
-// formats, both functions, keys only and MASK.
+// 2, 4, 8, 16 and 25 spp (at 4, 8, 16, samples tested from masks take a
+// pixel's four samples as one vector, ties included; 25: an odd grid,
+// 1280 units a pixel), both float formats, both functions, keys only and MASK.
 RASTRAY_TEST_LABELS_OF(CoverageEquivalence, SmallTrianglesAcrossBlocksWriteTheReferenceKeysAndWinners,
                        "quick");
 TEST(CoverageEquivalence, SmallTrianglesAcrossBlocksWriteTheReferenceKeysAndWinners) {
@@ -441,7 +441,7 @@ TEST(CoverageEquivalence, SmallTrianglesAcrossBlocksWriteTheReferenceKeysAndWinn
     return ((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ uint32_t(s) ^ tri.triangle) % 5 != 0;
   };
   const TileGrid tiles(kSize, kSize);
-  for (const int spp : {1, 2, 4, 8, 16})
+  for (const int spp : {1, 2, 4, 8, 16, 25})
     for (const Camera* camera : {&ortho, &persp}) {
       const DepthFormat format = camera == &ortho ? DepthFormat::FloatReversed : DepthFormat::Float;
       const SampleGrid grid = makeSampleGrid(spp, kSize, kSize);

@@ -71,16 +71,23 @@ TEST(DepthKeys, RowKeysMatchTheScalarKeyBitForBit) {
   }
 }
 
+// A depth plane of a few thousand pixels' range with v0 in [lowest, highest).
+Plane randomPlane(std::mt19937& rng, double lowest, double highest) {
+  const auto u = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  Plane p;
+  p.v0 = u(lowest, highest);
+  p.dx = u(-1e-2, 1e-2);
+  p.dy = u(-1e-2, 1e-2);
+  p.x0 = u(-100, 3000);
+  p.y0 = u(-100, 3000);
+  return p;
+}
+
 TEST(DepthKeys, RowTermsAreThePlaneAtTheSample) {
   std::mt19937 rng(3);
   const auto u = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
   for (int round = 0; round < 2000; ++round) {
-    Plane p;
-    p.v0 = u(-2, 2);
-    p.dx = u(-1e-2, 1e-2);
-    p.dy = u(-1e-2, 1e-2);
-    p.x0 = u(-100, 3000);
-    p.y0 = u(-100, 3000);
+    const Plane p = randomPlane(rng, -2, 2);
     const int px0 = int(rng() % 2048), py = int(rng() % 2048);
     const double ox = u(0, 1), oy = u(0, 1);
     double column[8];
@@ -93,6 +100,33 @@ TEST(DepthKeys, RowTermsAreThePlaneAtTheSample) {
     }
   }
 }
+
+#if defined(__SSE2__)
+// The lanes of a pixel's four samples that the depth pass tests from masks
+// at 4, 8 and 16 spp (pixelSampleKeys) against depthKey(format, p.at(x, y))
+// at the same positions, planes that leave [0, 1] included (the clamp).
+TEST(DepthKeys, PixelSampleKeysAreTheScalarKeyAtEachSample) {
+  std::mt19937 rng(5);
+  const auto u = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  for (int round = 0; round < 4000; ++round) {
+    const Plane p = randomPlane(rng, -0.5, 1.5);
+    const int px = int(rng() % 2048), py = int(rng() % 2048);
+    double qx[4], qy[4];
+    for (int k = 0; k < 4; ++k) {
+      qx[k] = u(0, 1);
+      qy[k] = u(0, 1);
+    }
+    for (const DepthFormat format : {DepthFormat::FloatReversed, DepthFormat::Float}) {
+      alignas(16) uint32_t keys[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(keys),
+                      pixelSampleKeys(format == DepthFormat::FloatReversed, p, px, py, qx, qy));
+      for (int k = 0; k < 4; ++k)
+        ASSERT_EQ(keys[k], depthKey(format, p.at(double(px) + qx[k], double(py) + qy[k])))
+            << toString(format) << " round " << round << " sample " << k;
+    }
+  }
+}
+#endif
 
 // One world unit per pixel for orthoCamera(size, size / 2).
 glm::vec3 world(int size, double x, double y, double z) {
