@@ -16,6 +16,7 @@
 #include "raster/depth.h"
 #include "raster/huge_pages.h"
 #include "raster/setup_classify.h"
+#include "raster/setup_planes.h"
 
 namespace rastray {
 
@@ -511,12 +512,38 @@ void setupChunkReference(const SetupContext& c, const SetupChunk& chunk, ChunkOu
   }
 }
 
+// The planes of a chunk's unclipped kept triangles (their setups written
+// but for the planes and centroid depth): in lanes (unclippedPlanes), and
+// the few the lanes leave by the scalar steps (clipOf, imageOf, setupPlanes
+// with planePositions' snapped fallback), the same bits either way.
+void unclippedChunkPlanes(const SetupContext& c, const std::vector<UnclippedTriangle>& unclipped,
+                          ChunkOutput* out) {
+  std::vector<uint32_t> scalar(unclipped.size());
+  const size_t n = unclippedPlanes(c.scene, c.space, c.depth, unclipped.data(), unclipped.size(),
+                                   out->setups.data(), scalar.data());
+  for (size_t k = 0; k < n; ++k) {
+    const UnclippedTriangle& u = unclipped[scalar[k]];
+    glm::dvec3 p[3];
+    loadPositions(c.scene, u.corners, p);
+    const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
+    TriangleSetup& t = out->setups[u.setup];
+    t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
+    const ClipVertex v[3] = {
+        {clip[0], glm::dvec3(1, 0, 0)}, {clip[1], glm::dvec3(0, 1, 0)}, {clip[2], glm::dvec3(0, 0, 1)}};
+    const glm::dvec2 image[3] = {c.space.imageOf(clip[0]), c.space.imageOf(clip[1]),
+                                 c.space.imageOf(clip[2])};
+    const int order[3] = {0, u.swapped ? 2 : 1, u.swapped ? 1 : 2};
+    setupPlanes(c.grid, c.depth, v, image, order, &t);
+  }
+}
+
 // The same setups and counters as setupChunkReference, from the vertex
 // codes: the outside, degenerate, culling, bounds and sample tests of a
 // triangle that needs no clipping are integer work on its vertices' codes
 // (its clip vertices are its own vertices, so setupTriangle would snap
-// them to the same positions); only a kept triangle is transformed again
-// for its planes. An instance without zero-area triangles (SPEC §1;
+// them to the same positions); only the kept triangles are transformed
+// again for their planes, after the loop and in lanes across triangles
+// (unclippedChunkPlanes). An instance without zero-area triangles (SPEC §1;
 // Instance::degenerateCount, which the loader and rebaseScene keep) skips
 // the world-area test, and its positions are loaded only for the
 // triangles kept or clipped.
@@ -533,6 +560,8 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
   TriangleSetup t;
   t.instance = chunk.instance;
   t.fromClipping = false;
+  std::vector<UnclippedTriangle> unclipped;
+  unclipped.reserve(chunk.count);
   const bool anyDegenerate = inst.degenerateCount != 0;
   for (uint32_t k = chunk.first; k < chunk.first + chunk.count; ++k) {
     if (c.filter.candidates && !((*c.filter.candidates)[inst.firstTriangle + k] & c.filter.candidateBit))
@@ -584,17 +613,15 @@ void setupChunkFast(const SetupContext& c, const VertexCodes& codes, const Setup
       ++n.noSample;
       continue;
     }
-    if (!anyDegenerate) loadPositions(c.scene, idx, p);
-    const glm::dvec4 clip[3] = {c.space.clipOf(p[0]), c.space.clipOf(p[1]), c.space.clipOf(p[2])};
-    t.centroidDepth = (clip[0].z + clip[1].z + clip[2].z) / 3.0;
     t.corners = idx;  // faceNormal: the chunk's, in lanes below
-    const ClipVertex v[3] = {
-        {clip[0], glm::dvec3(1, 0, 0)}, {clip[1], glm::dvec3(0, 1, 0)}, {clip[2], glm::dvec3(0, 0, 1)}};
-    const glm::dvec2 image[3] = {c.space.imageOf(clip[0]), c.space.imageOf(clip[1]),
-                                 c.space.imageOf(clip[2])};
-    setupPlanes(c.grid, c.depth, v, image, order, &t);
+    // Its clip vertices are its own (unit weights): every edge is the
+    // original triangle's (markOriginalEdges). The planes: the chunk's, in
+    // lanes below.
+    for (EdgeFunction& e : t.edge) e.original = true;
+    unclipped.push_back({uint32_t(out->setups.size()), idx, order[1] == 2});
     out->setups.push_back(t);
   }
+  unclippedChunkPlanes(c, unclipped, out);
   // Every setup's (clipped pieces' again: the same bits).
   faceNormals(c.scene, out->setups.data(), out->setups.size());
 }

@@ -168,8 +168,9 @@ SetupOutcome setupTriangle(const ClipSpace& space, const SampleGrid& grid, const
 
 // The same with the planes' scalar reference (one division per plane
 // coefficient and per vertex attribute, as written), which setupTriangle
-// and prepareTriangles match bit for bit with paired divisions: for the
-// equivalence test (tests/raster/setup_test.cpp).
+// matches bit for bit with paired divisions and prepareTriangles' fast
+// path with lanes across triangles (raster/setup_planes.h): for the
+// equivalence tests (tests/raster/setup_test.cpp, setup_lanes_test.cpp).
 SetupOutcome setupTriangleScalarPlanes(const ClipSpace& space, const SampleGrid& grid,
                                        const DepthSettings& depth, const ClipVertex v[3], CullMode cull,
                                        TriangleSetup* out);

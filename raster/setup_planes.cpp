@@ -1,11 +1,12 @@
-// The refinement planes of setup.h (RefinePlane) a block of triangles at a
-// time in Highway double lanes. Highway compiles the lane function once per
+// The refinement planes of setup.h (RefinePlane), the face normals and the
+// kept unclipped triangles' planes (setup_planes.h) a block of triangles at
+// a time in Highway double lanes. Highway compiles the lane function once per
 // SIMD target (foreach_target.h re-includes this file); the host code
 // gathers the corners, runs the lanes and scatters. Built with
 // -ffp-contract=off (the top-level CMakeLists.txt): every operation below
 // is the reference's (planeMemoFor's sorting network and subtractions in
-// common/surface.cpp, glm's cross and dot), in its order, so the bits are
-// the same on every target.
+// common/surface.cpp, glm's cross and dot; clipOf, imageOf, windowDepth
+// and setupPlanes), in its order, so the bits are the same on every target.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/setup_planes.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -16,6 +17,7 @@
 #include <hwy/highway.h>
 
 #include "raster/setup.h"
+#include "raster/setup_planes.h"
 
 #ifndef RASTRAY_SETUP_PLANES_BLOCK_
 #define RASTRAY_SETUP_PLANES_BLOCK_
@@ -37,6 +39,34 @@ struct NormalBlock {
   size_t lanes = 0;                    // a whole number of vectors
   alignas(64) double c[3][3][kBlock];  // [corner][axis][lane]
   alignas(64) double n[3][kBlock];     // [axis][lane]
+};
+
+// windowDepth's formula (common/depth_formula.cpp) for one frame's depth
+// settings.
+enum class DepthFormula { Orthographic, PerspectiveInfinite, PerspectiveFinite };
+
+// What a frame's unclipped planes share: the view transform's rows x, y and z
+// (glm's columns m[c][r]), clipOf's scale, imageOf's image size and
+// windowDepth's formula.
+struct UnclippedFrame {
+  double m[4][3];
+  double scaleX, scaleY, width, height;
+  bool perspective;  // clip w = d, else 1
+  DepthFormula formula;
+  bool reversed;
+  double znear, zfar, range;  // range = zfar − znear, as windowDepth forms it
+};
+
+// A block of unclipped triangles' world positions (in the setup's vertex
+// order) and their planes.
+struct UnclippedBlock {
+  size_t lanes = 0;                    // a whole number of vectors
+  alignas(64) double p[3][3][kBlock];  // [vertex][axis][lane]
+  alignas(64) double swapped[kBlock];  // 1: vertex order (0, 2, 1), 0: (0, 1, 2)
+  alignas(64) double scalar[kBlock];   // 1: left to the scalar steps
+  alignas(64) double x0[kBlock], y0[kBlock], centroid[kBlock], maxZ[kBlock];
+  alignas(64) double v0[3][kBlock];                 // z, 1/w, d/w at vertex 0 (b1/w, b2/w are +0 there)
+  alignas(64) double dx[5][kBlock], dy[5][kBlock];  // z, 1/w, d/w, b1/w, b2/w
 };
 
 }  // namespace setup_planes_detail
@@ -138,6 +168,89 @@ void LanesFaceNormals(setup_planes_detail::NormalBlock* b) {
   }
 }
 
+// Per lane and vertex, setupChunkFast's scalar steps: clipOf (glm's dmat4 ×
+// dvec4(p, 1) = (m0·x + m1·y) + (m2·z + m3), where m3·1 is m3 exactly; d =
+// −view.z; x and y over the scale; w = d or 1), imageOf ((x/w + 1)·0.5·W,
+// (1 − y/w)·0.5·H) and windowDepth (d); the centroid's view depth over the
+// stored order; then setupPlanes: planePositions' area, 1/w and d/w per
+// vertex, b/w as 1/w for a weight of 1 and +0 for 0 (w > 0), the ten
+// coefficients and the largest z, std::max's first largest. Lanes whose
+// area is not positive and finite, or with a w not positive, are marked
+// for the scalar steps.
+void LanesUnclippedPlanes(setup_planes_detail::UnclippedBlock* b,
+                          const setup_planes_detail::UnclippedFrame* f) {
+  using setup_planes_detail::DepthFormula;
+  const hn::ScalableTag<double> d;
+  using V = hn::Vec<decltype(d)>;
+  const size_t N = hn::Lanes(d);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), half = hn::Set(d, 0.5), three = hn::Set(d, 3.0);
+  const V scaleX = hn::Set(d, f->scaleX), scaleY = hn::Set(d, f->scaleY);
+  const V width = hn::Set(d, f->width), height = hn::Set(d, f->height);
+  const V znear = hn::Set(d, f->znear), zfar = hn::Set(d, f->zfar), range = hn::Set(d, f->range);
+  V m[4][3];
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 3; ++r) m[c][r] = hn::Set(d, f->m[c][r]);
+  // conventionalWindowDepth / reversedWindowDepth at view depth v.
+  const auto windowDepth = [&](const V& v) -> V {
+    switch (f->formula) {
+      case DepthFormula::Orthographic:
+        return f->reversed ? hn::Div(hn::Sub(zfar, v), range) : hn::Div(hn::Sub(v, znear), range);
+      case DepthFormula::PerspectiveInfinite:
+        return f->reversed ? hn::Div(znear, v) : hn::Sub(one, hn::Div(znear, v));
+      case DepthFormula::PerspectiveFinite:
+        return f->reversed ? hn::Div(hn::Mul(znear, hn::Sub(zfar, v)), hn::Mul(v, range))
+                           : hn::Div(hn::Mul(zfar, hn::Sub(v, znear)), hn::Mul(v, range));
+    }
+    return v;
+  };
+  for (size_t i = 0; i < b->lanes; i += N) {
+    V x[3], y[3], view[3], w[3], attr[5][3];  // attr: z, 1/w, d/w, b1/w, b2/w
+    for (int s = 0; s < 3; ++s) {
+      const V px = hn::Load(d, b->p[s][0] + i), py = hn::Load(d, b->p[s][1] + i),
+              pz = hn::Load(d, b->p[s][2] + i);
+      const auto row = [&](int r) {
+        return hn::Add(hn::Add(hn::Mul(m[0][r], px), hn::Mul(m[1][r], py)),
+                       hn::Add(hn::Mul(m[2][r], pz), m[3][r]));
+      };
+      view[s] = hn::Neg(row(2));
+      w[s] = f->perspective ? view[s] : one;
+      const V cx = hn::Div(row(0), scaleX), cy = hn::Div(row(1), scaleY);
+      x[s] = hn::Mul(hn::Mul(hn::Add(hn::Div(cx, w[s]), one), half), width);
+      y[s] = hn::Mul(hn::Mul(hn::Sub(one, hn::Div(cy, w[s])), half), height);
+      attr[0][s] = windowDepth(view[s]);
+      attr[1][s] = hn::Div(one, w[s]);
+      attr[2][s] = hn::Div(view[s], w[s]);
+    }
+    const auto positiveW = hn::And(hn::And(hn::Gt(w[0], zero), hn::Gt(w[1], zero)), hn::Gt(w[2], zero));
+    const auto swapped = hn::Ne(hn::Load(d, b->swapped + i), zero);
+    // Stored corner 1 is vertex 2 when swapped, else vertex 1; corner 2 the other.
+    attr[3][0] = attr[4][0] = zero;
+    attr[3][1] = hn::IfThenZeroElse(swapped, attr[1][1]);
+    attr[3][2] = hn::IfThenElseZero(swapped, attr[1][2]);
+    attr[4][1] = hn::IfThenElseZero(swapped, attr[1][1]);
+    attr[4][2] = hn::IfThenZeroElse(swapped, attr[1][2]);
+    const V corner1 = hn::IfThenElse(swapped, view[2], view[1]);
+    const V corner2 = hn::IfThenElse(swapped, view[1], view[2]);
+    hn::Store(hn::Div(hn::Add(hn::Add(view[0], corner1), corner2), three), d, b->centroid + i);
+    const V x10 = hn::Sub(x[1], x[0]), x20 = hn::Sub(x[2], x[0]);
+    const V y10 = hn::Sub(y[1], y[0]), y20 = hn::Sub(y[2], y[0]);
+    const V area = hn::Sub(hn::Mul(x10, y20), hn::Mul(y10, x20));
+    const auto scalar = hn::Not(hn::And(positiveW, hn::And(hn::Gt(area, zero), hn::IsFinite(area))));
+    hn::Store(hn::IfThenElseZero(scalar, one), d, b->scalar + i);
+    for (int k = 0; k < 5; ++k) {
+      const V a10 = hn::Sub(attr[k][1], attr[k][0]), a20 = hn::Sub(attr[k][2], attr[k][0]);
+      hn::Store(hn::Div(hn::Sub(hn::Mul(a10, y20), hn::Mul(a20, y10)), area), d, b->dx[k] + i);
+      hn::Store(hn::Div(hn::Sub(hn::Mul(a20, x10), hn::Mul(a10, x20)), area), d, b->dy[k] + i);
+    }
+    for (int k = 0; k < 3; ++k) hn::Store(attr[k][0], d, b->v0[k] + i);
+    hn::Store(x[0], d, b->x0 + i), hn::Store(y[0], d, b->y0 + i);
+    V maxZ = attr[0][0];
+    maxZ = hn::IfThenElse(hn::Lt(maxZ, attr[0][1]), attr[0][1], maxZ);
+    maxZ = hn::IfThenElse(hn::Lt(maxZ, attr[0][2]), attr[0][2], maxZ);
+    hn::Store(maxZ, d, b->maxZ + i);
+  }
+}
+
 size_t PlaneLanes() { return hn::Lanes(hn::ScalableTag<double>()); }
 
 }  // namespace HWY_NAMESPACE
@@ -147,13 +260,16 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 
 #include <algorithm>
+#include <cmath>
 
 #include "common/triangle_plane.h"
+#include "raster/depth.h"
 
 namespace rastray {
 
 HWY_EXPORT(LanesRefinePlanes);
 HWY_EXPORT(LanesFaceNormals);
+HWY_EXPORT(LanesUnclippedPlanes);
 HWY_EXPORT(PlaneLanes);
 
 RefinePlane refinePlaneReference(const Scene& scene, uint32_t instance, uint32_t triangle,
@@ -194,6 +310,91 @@ size_t padCorners(size_t n, size_t vectorLanes, CornerLanes& c) {
 }
 
 }  // namespace
+
+namespace {
+
+// The frame's constants of LanesUnclippedPlanes.
+setup_planes_detail::UnclippedFrame unclippedFrame(const ClipSpace& space, const DepthSettings& depth) {
+  using setup_planes_detail::DepthFormula;
+  setup_planes_detail::UnclippedFrame f;
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 3; ++r) f.m[c][r] = space.viewFromWorld[c][r];
+  f.scaleX = space.scale.x, f.scaleY = space.scale.y;
+  f.width = double(space.width), f.height = double(space.height);
+  f.perspective = space.projection == Projection::Perspective;
+  f.formula = depth.projection == Projection::Orthographic ? DepthFormula::Orthographic
+              : std::isinf(depth.zfar)                     ? DepthFormula::PerspectiveInfinite
+                                                           : DepthFormula::PerspectiveFinite;
+  f.reversed = isReversed(depth.format);
+  f.znear = depth.znear, f.zfar = depth.zfar, f.range = depth.zfar - depth.znear;
+  return f;
+}
+
+// Lane k of a block: the triangle's world positions in its setup's vertex order.
+void gatherUnclipped(const Scene& scene, const UnclippedTriangle& u, size_t k,
+                     setup_planes_detail::UnclippedBlock& b) {
+  const uint32_t corner[3] = {u.corners.x, u.swapped ? u.corners.z : u.corners.y,
+                              u.swapped ? u.corners.y : u.corners.z};
+  for (int i = 0; i < 3; ++i) {
+    const glm::vec3& p = scene.positions[corner[i]];
+    b.p[i][0][k] = double(p.x), b.p[i][1][k] = double(p.y), b.p[i][2][k] = double(p.z);
+  }
+  b.swapped[k] = u.swapped ? 1.0 : 0.0;
+}
+
+// Pads the n gathered lanes to whole vectors with the last triangle again
+// (never read back); returns the lanes the kernel runs.
+size_t padUnclipped(size_t n, size_t vectorLanes, setup_planes_detail::UnclippedBlock& b) {
+  const size_t lanes = (n + vectorLanes - 1) / vectorLanes * vectorLanes;
+  for (size_t k = n; k < lanes; ++k) {
+    for (int i = 0; i < 3; ++i)
+      for (int a = 0; a < 3; ++a) b.p[i][a][k] = b.p[i][a][n - 1];
+    b.swapped[k] = b.swapped[n - 1];
+  }
+  return lanes;
+}
+
+// Lane k's planes into t, and setupPlanes' polygon offset.
+void scatterUnclipped(const setup_planes_detail::UnclippedBlock& b, size_t k, const DepthSettings& ds,
+                      TriangleSetup* t) {
+  t->centroidDepth = b.centroid[k];
+  t->depth = {b.v0[0][k], b.dx[0][k], b.dy[0][k], b.x0[k], b.y0[k]};
+  t->invW = {b.v0[1][k], b.dx[1][k], b.dy[1][k]};
+  t->dOverW = {b.v0[2][k], b.dx[2][k], b.dy[2][k]};
+  t->b1OverW = {0.0, b.dx[3][k], b.dy[3][k]};
+  t->b2OverW = {0.0, b.dx[4][k], b.dy[4][k]};
+  const double offset =
+      polygonOffset(ds.format, ds.offsetFactor, ds.offsetUnits, t->maxDepthSlope(), b.maxZ[k]);
+  t->depth.v0 += isReversed(ds.format) ? -offset : offset;
+}
+
+}  // namespace
+
+size_t unclippedPlanes(const Scene& scene, const ClipSpace& space, const DepthSettings& depth,
+                       const UnclippedTriangle* triangles, size_t n, TriangleSetup* setups,
+                       uint32_t* scalar) {
+  using setup_planes_detail::kBlock;
+  if (n == 0) return 0;
+  // Per thread: 14 KB, reused by every chunk the thread sets up.
+  thread_local setup_planes_detail::UnclippedBlock block;
+  setup_planes_detail::UnclippedBlock& b = block;
+  const setup_planes_detail::UnclippedFrame frame = unclippedFrame(space, depth);
+  const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(PlaneLanes)();
+  size_t scalarCount = 0;
+  for (size_t first = 0; first < n; first += kBlock) {
+    const size_t count = std::min(kBlock, n - first);
+    for (size_t k = 0; k < count; ++k) gatherUnclipped(scene, triangles[first + k], k, b);
+    b.lanes = padUnclipped(count, vectorLanes, b);
+    HWY_DYNAMIC_DISPATCH(LanesUnclippedPlanes)(&b, &frame);
+    for (size_t k = 0; k < count; ++k) {
+      if (b.scalar[k] != 0.0)
+        scalar[scalarCount++] = uint32_t(first + k);
+      else
+        scatterUnclipped(b, k, depth, &setups[triangles[first + k].setup]);
+    }
+  }
+  return scalarCount;
+}
 
 void refinePlanes(const Scene& scene, const TriangleSetup* setups, size_t count, const glm::dvec3& eye,
                   RefinePlane* out) {
