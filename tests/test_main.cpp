@@ -88,9 +88,12 @@ int writeCtestFile(const std::string& out, const std::string& module, const std:
       const std::string name = fullName(info);
       script += "add_test(" + bracket(name) + " " + bracket(program) + " " +
                 bracket("--gtest_filter=" + name) + " --gtest_also_run_disabled_tests)\n";
+      // COST: `ctest -j` starts the slow tests first on a fresh build (no
+      // CTestCostData yet, as in CI), so a long one does not end the run
+      // alone on one core while the other idles.
       script += "set_tests_properties(" + bracket(name) + " PROPERTIES WORKING_DIRECTORY " +
                 bracket(workdir) + " SKIP_REGULAR_EXPRESSION [==[\\[  SKIPPED \\]]==] LABELS " +
-                bracket(labelList) + ")\n";
+                bracket(labelList) + (all.count("slow") ? " COST 60" : "") + ")\n";
     }
   }
   // Written whole, then renamed: ctest never reads half a list.
