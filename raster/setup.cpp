@@ -15,7 +15,7 @@
 #include "common/triangle_plane.h"
 #include "raster/depth.h"
 #include "raster/huge_pages.h"
-#include "raster/setup_classify.h"
+#include "raster/setup_vertex_codes.h"
 #include "raster/setup_planes.h"
 
 namespace rastray {

@@ -1,6 +1,6 @@
-// The vertex codes in lanes (raster/setup_classify.h) against the scalar
+// The vertex codes in lanes (raster/setup_vertex_codes.h) against the scalar
 // reference, on every Highway target.
-#include "raster/setup_classify.h"
+#include "raster/setup_vertex_codes.h"
 
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
@@ -51,7 +51,7 @@ void expectReferenceCodes(const ClipSpace& space, double unitsPerPixel,
 // Random vertices in front of, beside, behind and beyond a perspective
 // camera (finite and infinite far plane), on its near and far planes,
 // and non-finite ones.
-TEST(SetupClassify, VertexCodesInLanesGiveTheReferenceBitsForAPerspectiveCameraOnEveryTarget) {
+TEST(SetupVertexCodes, VertexCodesInLanesGiveTheReferenceBitsForAPerspectiveCameraOnEveryTarget) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
@@ -81,7 +81,7 @@ TEST(SetupClassify, VertexCodesInLanesGiveTheReferenceBitsForAPerspectiveCameraO
 // boundaries, half a unit off them both ways (round half away from zero
 // at every tie, either sign), on the guard band's edges and just beyond,
 // and with a guard band so wide that the clamp to ±2^29 units decides.
-TEST(SetupClassify, VertexCodesInLanesGiveTheReferenceBitsOnTiesEdgesAndTheClampOnEveryTarget) {
+TEST(SetupVertexCodes, VertexCodesInLanesGiveTheReferenceBitsOnTiesEdgesAndTheClampOnEveryTarget) {
   const int size = 1024;
   const SampleGrid grid = makeSampleGrid(1, size, size);
   const double U = double(grid.unitsPerPixel);

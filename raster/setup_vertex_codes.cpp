@@ -1,4 +1,4 @@
-// The vertex codes of setup_classify.h in Highway double lanes. Highway
+// The vertex codes of setup_vertex_codes.h in Highway double lanes. Highway
 // compiles the lane function once per SIMD target (foreach_target.h
 // re-includes this file); the host code gathers a block of positions,
 // runs the lanes and scatters the codes. Built with -ffp-contract=off (the
@@ -8,7 +8,7 @@
 // addition, multiplication and division are correctly rounded in every
 // lane, so the bits are the same on every target.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "raster/setup_classify.cpp"
+#define HWY_TARGET_INCLUDE "raster/setup_vertex_codes.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 
 #include <cstddef>
@@ -17,12 +17,12 @@
 #include <hwy/highway.h>
 
 #include "raster/setup.h"
-#include "raster/setup_classify.h"
+#include "raster/setup_vertex_codes.h"
 
 #ifndef RASTRAY_SETUP_CLASSIFY_BLOCK_
 #define RASTRAY_SETUP_CLASSIFY_BLOCK_
 namespace rastray {
-namespace setup_classify_detail {
+namespace setup_vertex_codes_detail {
 
 constexpr size_t kBlock = 64;  // a multiple of every target's double lane count
 
@@ -44,7 +44,7 @@ struct VertexBlock {
   alignas(64) double snapped[2][kBlock];  // [axis][lane]; 0 where outside
 };
 
-}  // namespace setup_classify_detail
+}  // namespace setup_vertex_codes_detail
 }  // namespace rastray
 #endif  // RASTRAY_SETUP_CLASSIFY_BLOCK_
 
@@ -59,8 +59,8 @@ namespace hn = hwy::HWY_NAMESPACE;
 // ((x/w + 1)·0.5·width, (1 − y/w)·0.5·height), times the units per pixel,
 // rounded half away from zero (trunc, then ±1 when the exact remainder's
 // magnitude is >= 0.5) and clamped to ±kMaxCoordinateUnits.
-void LanesVertexCodes(const setup_classify_detail::VertexTransform* f,
-                      setup_classify_detail::VertexBlock* b) {
+void LanesVertexCodes(const setup_vertex_codes_detail::VertexTransform* f,
+                      setup_vertex_codes_detail::VertexBlock* b) {
   const hn::ScalableTag<double> d;
   using V = hn::Vec<decltype(d)>;
   const size_t N = hn::Lanes(d);
@@ -122,8 +122,8 @@ HWY_EXPORT(VertexLanes);
 
 namespace {
 
-setup_classify_detail::VertexTransform transformOf(const ClipSpace& space, double unitsPerPixel) {
-  setup_classify_detail::VertexTransform f;
+setup_vertex_codes_detail::VertexTransform transformOf(const ClipSpace& space, double unitsPerPixel) {
+  setup_vertex_codes_detail::VertexTransform f;
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 3; ++r) f.view[c][r] = space.viewFromWorld[c][r];
   f.scale[0] = space.scale.x, f.scale[1] = space.scale.y;
@@ -140,12 +140,12 @@ setup_classify_detail::VertexTransform transformOf(const ClipSpace& space, doubl
 
 void vertexCodes(const ClipSpace& space, double unitsPerPixel, const glm::vec3* positions, size_t count,
                  uint8_t* outside, SnappedVertex* snapped) {
-  using setup_classify_detail::kBlock;
+  using setup_vertex_codes_detail::kBlock;
   if (count == 0) return;
   // Per thread: 3 KB, reused by every block the thread classifies.
-  thread_local setup_classify_detail::VertexBlock block;
-  setup_classify_detail::VertexBlock& b = block;
-  const setup_classify_detail::VertexTransform f = transformOf(space, unitsPerPixel);
+  thread_local setup_vertex_codes_detail::VertexBlock block;
+  setup_vertex_codes_detail::VertexBlock& b = block;
+  const setup_vertex_codes_detail::VertexTransform f = transformOf(space, unitsPerPixel);
   const size_t vectorLanes = HWY_DYNAMIC_DISPATCH(VertexLanes)();
   for (size_t first = 0; first < count; first += kBlock) {
     const size_t n = std::min(kBlock, count - first);
