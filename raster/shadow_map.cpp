@@ -317,15 +317,11 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
     centre = 0.5 * (scene.bounds.lo + scene.bounds.hi);
     radius = std::max(1e-6, 0.5 * glm::length(scene.bounds.hi - scene.bounds.lo));
   }
-  // Every light's maps, lights in order: their cameras and, for a cube
-  // map, which faces each triangle can reach.
-  struct MapOfLight {
-    size_t light, index;
-    Camera camera;
-    TriangleFilter filter;
-  };
-  std::vector<MapOfLight> all;
-  std::vector<std::vector<uint8_t>> faces(scene.lights.size());
+  // Every light's maps, lights in order, one map after another, each over
+  // its tiles in parallel. Maps in parallel too (nested loops) measured no
+  // gain at the default size and made ThreadSanitizer report a race it
+  // cannot trace (a worker's read of the main thread's stack, its history
+  // lost).
   perLight_.resize(scene.lights.size());
   for (size_t l = 0; l < scene.lights.size(); ++l) {
     const Light& light = scene.lights[l];
@@ -343,27 +339,20 @@ ShadowMaps::ShadowMaps(const Scene& scene, const RasterOptions& options, const S
         cameras = cubeFaceCameras(light.position, size, znear);
     }
     const bool cube = cameras.size() == kCubeFaces;
+    std::vector<uint8_t> faces;  // a cube map's: which faces each triangle can reach
     if (cube) {
       const ClipSpace space = makeClipSpace(cameras[0], makeSampleGrid(1, size, size).guardPixels);
-      faces[l] = cubeFaceCandidates(scene, light.position, space.scale.x, size);
+      faces = cubeFaceCandidates(scene, light.position, space.scale.x, size);
     }
     perLight_[l].resize(cameras.size());
-    for (size_t f = 0; f < cameras.size(); ++f)
-      all.push_back({l, f, cameras[f],
-                     TriangleFilter{true, true, cube ? &faces[l] : nullptr, uint8_t(cube ? 1u << f : 0u)}});
-  }
-  // One map after another, each over its tiles in parallel. Maps in
-  // parallel too (nested loops) measured no gain at the default size and
-  // made ThreadSanitizer report a race it cannot trace (a worker's read
-  // of the main thread's stack, its history lost).
-  std::vector<uint64_t> trianglesIn(all.size(), 0);
-  for (size_t i = 0; i < all.size(); ++i) {
-    const MapOfLight& m = all[i];
-    renderMap(scene, options, shader, path, m.camera, size, m.filter, &perLight_[m.light][m.index],
-              &trianglesIn[i]);
+    for (size_t f = 0; f < cameras.size(); ++f) {
+      const TriangleFilter filter{true, true, cube ? &faces : nullptr, uint8_t(cube ? 1u << f : 0u)};
+      uint64_t trianglesIn = 0;
+      renderMap(scene, options, shader, path, cameras[f], size, filter, &perLight_[l][f], &trianglesIn);
+      triangles_ += trianglesIn;
+    }
   }
   throwIfStopped(options.cancel);
-  for (uint64_t n : trianglesIn) triangles_ += n;
   for (const auto& maps : perLight_)
     for (const Map& m : maps) {
       maps_.push_back(&m);
